@@ -1,0 +1,46 @@
+#pragma once
+// The finite MDP abstraction of a configuration: grids, dynamics, noise and the cell roles of the
+// specification. Every engine takes this and returns a Policy.
+//
+// Safety, reachability and reach-avoid share one recursion. Each state cell has a role:
+//   Free:      V_k(x) = max_u min_w sum_{x'} T(x'|x,u,w) V_{k+1}(x')
+//   FixedOne:  V_k(x) = 1 for all k      (reach: the target G)
+//   FixedZero: V_k(x) = 0 for all k      (avoid set A; safety: cells outside S)
+// Terminal values V_{T_d}: safety 1 on Free cells; reach(-avoid) 0 on Free cells. Mass leaving
+// the grid counts 0. This is exactly SPEC section 2's definitions (for reach-avoid, G counts 1
+// and A counts 0 inside the sum, and V = 1 on G, 0 on A).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "amytiss/config.hpp"
+#include "amytiss/grid.hpp"
+#include "amytiss/model.hpp"
+#include "amytiss/noise.hpp"
+
+namespace amytiss {
+
+enum class CellRole : std::uint8_t { Free = 0, FixedZero = 1, FixedOne = 2 };
+
+struct Abstraction {
+  Config config;
+  Grid states;
+  Grid inputs;        ///< zero dimensions (one point) for an autonomous system
+  Grid disturbances;  ///< zero dimensions (one point) without disturbances
+  std::shared_ptr<const Dynamics> dynamics;
+  std::shared_ptr<const NoiseModel> noise;
+  std::vector<CellRole> roles;  ///< per state cell (flat index)
+  SpecType spec = SpecType::Safety;
+  unsigned horizon = 0;
+
+  /// Validates and builds. Throws ConfigError.
+  static Abstraction from_config(const Config& config);
+
+  /// V_{T_d} of a cell with the given role.
+  double terminal_value(CellRole role) const;
+  /// Number of (state, input) pairs and (state, input, disturbance) triples.
+  std::size_t pairs() const { return states.size() * inputs.size(); }
+  std::size_t triples() const { return pairs() * disturbances.size(); }
+};
+
+}  // namespace amytiss

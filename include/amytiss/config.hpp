@@ -1,0 +1,107 @@
+#pragma once
+// The one configuration of a synthesis problem (SPEC section 3). The same schema is read from a
+// YAML file (CLI) and from ROS parameters (the ROS layer converts its XmlRpc tree to YAML::Node).
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace amytiss {
+
+/// An axis-aligned box {lb, ub}; bounds in the units of the space it lives in.
+struct Box {
+  std::vector<double> lb;
+  std::vector<double> ub;
+};
+
+/// A uniform grid over a box: points lb + k*eta, k = 0..n-1, n = floor((ub-lb)/eta + 0.5) + 1.
+struct GridSpec {
+  std::vector<double> lb;
+  std::vector<double> ub;
+  std::vector<double> eta;  ///< spacing per dimension, > 0
+};
+
+enum class NoiseType { Additive, Multiplicative };
+enum class Distribution { Normal, Uniform };
+enum class Truncation { None, FixedRegion, CuttingProbability };
+
+struct NoiseConfig {
+  NoiseType type = NoiseType::Additive;
+  Distribution distribution = Distribution::Normal;
+  /// normal: covariance, either n values (diagonal) or n*n values (full, row-major, symmetric
+  /// positive definite). Units: state units squared.
+  std::vector<double> covariance;
+  /// uniform: half-width of the support per dimension (noise uniform on [-h, h]).
+  std::vector<double> half_width;
+  Truncation truncation = Truncation::CuttingProbability;
+  /// cutting_probability: total probability mass that may be cut per transition, in (0, 1).
+  double cutting_probability = 1e-3;
+  /// fixed_region: half-widths of the kept box around the post mean, per dimension (state units).
+  std::vector<double> fixed_region;
+};
+
+enum class SpecType { Safety, Reachability, ReachAvoid };
+
+struct SpecConfig {
+  SpecType type = SpecType::Safety;
+  unsigned horizon = 0;       ///< T_d, number of steps, >= 1
+  std::optional<Box> safe;    ///< safety; absent: the whole grid
+  std::optional<Box> target;  ///< reachability, reach_avoid
+  std::optional<Box> avoid;   ///< reach_avoid (absent: empty)
+};
+
+enum class DeviceKind { Auto, Cpu, Gpu, Reference };
+enum class TransitionStorage { Auto, Stored, OnTheFly };
+
+struct ComputeConfig {
+  DeviceKind device = DeviceKind::Auto;
+  TransitionStorage transitions = TransitionStorage::Auto;
+  /// Optional OpenCL platform/device selection: a 0-based index ("1") or a case-insensitive
+  /// substring of the platform or device name ("nvidia"). Empty: any.
+  std::string platform;
+  std::string device_name;
+  /// Fraction of the device's reported global memory the engine may use, in (0, 1].
+  double memory_fraction = 0.5;
+};
+
+struct Config {
+  std::string name;
+  GridSpec states;
+  std::optional<GridSpec> inputs;        ///< absent: autonomous system (one empty input)
+  std::optional<GridSpec> disturbances;  ///< absent: no adversary
+  std::map<std::string, double> constants;
+  std::vector<std::string> dynamics;     ///< one expression per state dimension, or empty with model
+  std::string model;                     ///< built-in model name ("bmw320i", "vehicle3d"), or empty
+  NoiseConfig noise;
+  SpecConfig spec;
+  ComputeConfig compute;
+
+  /// Throws ConfigError for the first problem found (SPEC section 7): dimensions that disagree,
+  /// eta <= 0, lb > ub, covariance not symmetric positive definite, expression that does not
+  /// parse (with column), unknown model, set outside the grid, horizon 0, grid too large.
+  void validate() const;
+};
+
+/// Parses a YAML tree of the schema. Throws ConfigError naming the key on a missing key, a wrong
+/// type, an unknown enum value or an unknown key. Calls validate().
+Config config_from_yaml(const YAML::Node& root);
+/// Reads and parses a YAML file (ConfigError with key "<file>" when it cannot be read).
+Config load_config_file(const std::string& path);
+/// Canonical YAML text of the configuration: all keys, fixed order, full precision. Parsing it
+/// again gives an equal Config.
+std::string to_yaml(const Config& config);
+/// Hash of the parts that determine the result (everything but `compute`), as 16 hex digits.
+std::string config_hash(const Config& config);
+
+/// Names used in messages and files: "safety", "reach_avoid", "normal", "auto", ...
+std::string to_string(SpecType);
+std::string to_string(DeviceKind);
+std::string to_string(TransitionStorage);
+std::string to_string(NoiseType);
+std::string to_string(Distribution);
+std::string to_string(Truncation);
+
+}  // namespace amytiss

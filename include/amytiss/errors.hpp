@@ -1,0 +1,54 @@
+#pragma once
+// Exceptions thrown by the amytiss core. The core never exits or logs-and-continues: every
+// failure is one of these, with a message meant for the user.
+#include <stdexcept>
+#include <string>
+
+namespace amytiss {
+
+/// A configuration value is missing or invalid. what() names the key, the value received and an
+/// example of a valid value, e.g.
+///   "states.eta[1]: got -0.5, expected a positive number (example: eta: [0.5, 0.5])".
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(const std::string& key, const std::string& message)
+      : std::runtime_error(key + ": " + message), key_(key) {}
+  /// The dotted configuration key at fault, e.g. "noise.covariance".
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string key_;
+};
+
+/// A dynamics expression does not parse. what() says the column (1-based) and what was expected.
+class ParseError : public std::runtime_error {
+ public:
+  ParseError(std::size_t column, const std::string& message)
+      : std::runtime_error("column " + std::to_string(column) + ": " + message), column_(column) {}
+  std::size_t column() const { return column_; }
+
+ private:
+  std::size_t column_;
+};
+
+/// A policy file cannot be read: missing, truncated, corrupt, of another format version, or made
+/// from another configuration.
+class PolicyFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// An OpenCL device could not be found, set up, or failed while running (kernel build errors
+/// carry the compiler's log).
+class DeviceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Synthesis was cancelled through the progress callback.
+class Cancelled : public std::runtime_error {
+ public:
+  Cancelled() : std::runtime_error("synthesis cancelled") {}
+};
+
+}  // namespace amytiss

@@ -1,0 +1,49 @@
+#pragma once
+// Dynamics expressions (SPEC section 3): a whitelisted grammar, evaluated in C++ and emitted as
+// OpenCL C. Nothing outside the grammar is accepted, so no parameter text reaches a compiler.
+//
+// Grammar (precedence low to high):
+//   expr    := cond
+//   cond    := or ( '?' expr ':' expr )?
+//   or      := and ( '||' and )*
+//   and     := cmp ( '&&' cmp )*
+//   cmp     := sum ( ('<' | '<=' | '>' | '>=' | '==' | '!=') sum )?
+//   sum     := product ( ('+' | '-') product )*
+//   product := unary ( ('*' | '/') unary )*
+//   unary   := ('-' | '+' | '!') unary | power
+//   power   := atom ( '^' unary )?            (right-associative: 2^3^2 = 2^9)
+//   atom    := number | variable | constant | function '(' expr (',' expr)* ')' | '(' expr ')'
+// Variables: x0.., u0.., w0.. (state, input, disturbance components). Constants: names given to
+// parse() (and pi). Functions: sin cos tan asin acos atan atan2 exp log sqrt pow abs min max floor
+// ceil, plus if(cond, a, b). Comparisons and logic give 1 or 0. Also: `cond ? a : b`.
+#include <map>
+#include <memory>
+#include <string>
+
+namespace amytiss {
+
+struct ExpressionNode;  // defined in the .cpp
+
+class Expression {
+ public:
+  /// Parses `text`. `constants` are named values substituted at parse time. Index limits: a
+  /// variable x<i> needs i < state_dims (likewise u, w). Throws ParseError (1-based column).
+  static Expression parse(const std::string& text, const std::map<std::string, double>& constants,
+                          std::size_t state_dims, std::size_t input_dims,
+                          std::size_t disturbance_dims);
+
+  /// Evaluates with the given component arrays (double precision).
+  double evaluate(const double* x, const double* u, const double* w) const;
+
+  /// OpenCL C (and C++) expression text over arrays named `x`, `u`, `w` of type double; numbers
+  /// are printed with 17 significant digits. Example: "(x[0] + (10.0 * (u[0] * cos(u[1]))))".
+  std::string to_c() const;
+
+  const std::string& text() const { return text_; }
+
+ private:
+  std::shared_ptr<const ExpressionNode> root_;
+  std::string text_;
+};
+
+}  // namespace amytiss

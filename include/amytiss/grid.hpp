@@ -1,0 +1,54 @@
+#pragma once
+// Uniform grids (SPEC section 2). Flat indices are row-major: the LAST dimension varies fastest,
+// flat = ((k0*n1 + k1)*n2 + k2)..., so a flat value array reshapes to numpy's (n0, n1, ...).
+// A grid with zero dimensions has exactly one (empty) point: autonomous systems, no disturbance.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "amytiss/config.hpp"
+
+namespace amytiss {
+
+class Grid {
+ public:
+  Grid() = default;  ///< zero dimensions, one point
+  explicit Grid(const GridSpec& spec);
+
+  std::size_t dims() const { return lb_.size(); }
+  std::size_t size() const { return size_; }          ///< number of points (product of counts)
+  std::size_t count(std::size_t dim) const { return counts_[dim]; }
+  const std::vector<std::size_t>& counts() const { return counts_; }
+  const std::vector<double>& lb() const { return lb_; }
+  const std::vector<double>& eta() const { return eta_; }
+  /// Last representative point per dimension (lb + (n-1)*eta; may differ from the spec's ub).
+  std::vector<double> last_point() const;
+
+  /// Representative coordinate of index k along dim: lb + k*eta.
+  double coordinate(std::size_t dim, std::size_t k) const { return lb_[dim] + double(k) * eta_[dim]; }
+  /// Writes the point of a flat index into out[0..dims).
+  void point(std::size_t flat, double* out) const;
+  std::vector<double> point(std::size_t flat) const;
+  /// Multi-index <-> flat index.
+  std::size_t flat_index(const std::size_t* multi) const;
+  void multi_index(std::size_t flat, std::size_t* multi) const;
+  /// Nearest representative index along dim (may be < 0 or >= count): floor((v-lb)/eta + 0.5).
+  std::int64_t nearest(std::size_t dim, double value) const;
+  /// Flat index of the cell containing `state` (nearest point per dimension), or nullopt when the
+  /// state lies outside the covered set (beyond half a cell from the outermost points) or is not
+  /// finite. O(dims), no allocation.
+  std::optional<std::size_t> cell_of(const double* state) const;
+  /// Whether the point of flat index lies in the closed box (with a 1e-9*eta tolerance).
+  bool point_in_box(std::size_t flat, const Box& box) const;
+
+ private:
+  std::vector<double> lb_, eta_;
+  std::vector<std::size_t> counts_, strides_;
+  std::size_t size_ = 1;
+};
+
+/// Number of points of one dimension: floor((ub - lb)/eta + 0.5) + 1.
+std::size_t grid_count(double lb, double ub, double eta);
+
+}  // namespace amytiss

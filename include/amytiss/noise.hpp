@@ -1,0 +1,93 @@
+#pragma once
+// Noise and exact transition probabilities (SPEC section 2).
+//
+// T(x' | x,u,w) = P( f(x,u,w) + noise in cell(x') ), cell(x') = [x' - eta/2, x' + eta/2].
+// Separable noise (normal with diagonal covariance, uniform) gives T as a product of
+// one-dimensional cell masses, each computed exactly (erfc for normal). Full covariance uses
+// box_mass() (see its comment for the method and error bound).
+//
+// Truncation window: for a post mean mu, the kept cells along dimension i are the indices
+//   nearest_i(mu) - h_i .. nearest_i(mu) + h_i      (clipped to the grid)
+// with h_i = window_half_cells()[i]:
+//   none:                h_i = n_i - 1 (the whole grid, whatever mu);
+//   fixed_region r:      h_i = floor(r_i/eta_i + 1e-9)  (the AMYTISS convention: a region of
+//                        2h+1 cells; BMW paper grid: 1*1*5*5*3*3*3 = 675 cells);
+//   cutting_probability gamma (normal): h_i = ceil(z*s_i/eta_i) with 2*(1 - Phi(z)) = gamma/n
+//                        and s_i the largest standard deviation of dimension i. The window
+//                        contains [mu - h_i*eta_i, mu + h_i*eta_i] because |mu - nearest| <=
+//                        eta/2, so the cut mass per transition is at most gamma (union bound).
+//   uniform:             h_i = ceil(a_i*s/eta_i) covers the whole support: nothing is cut.
+// Cells outside the window get probability 0, so every value computed is a lower bound.
+// Multiplicative noise: noise_i scales with |x_i| of the current state (diagonal only).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "amytiss/config.hpp"
+#include "amytiss/grid.hpp"
+
+namespace amytiss {
+
+class NoiseModel {
+ public:
+  /// Throws ConfigError for a covariance that is not symmetric positive definite, etc.
+  NoiseModel(const NoiseConfig& config, const Grid& states);
+
+  std::size_t dims() const { return dims_; }
+  NoiseType type() const { return type_; }
+  Distribution distribution() const { return distribution_; }
+  /// True when T is the product of per-dimension masses (normal diagonal, uniform).
+  bool separable() const { return separable_; }
+
+  /// Scale of dimension `dim` at current state x: normal: standard deviation sqrt(Sigma_ii);
+  /// uniform: half-width; multiplicative: times |x[dim]|.
+  double scale(std::size_t dim, const double* x) const;
+  /// Base scale (the additive one): stddev or half-width per dimension.
+  const std::vector<double>& base_scale() const { return base_scale_; }
+
+  /// h_i per dimension (see above); the window has 2*h_i + 1 cells before clipping.
+  const std::vector<std::int64_t>& window_half_cells() const { return window_half_cells_; }
+  /// Cells in the unclipped window: product of (2h_i + 1), capped at the grid size.
+  std::size_t window_cells() const;
+  /// Upper bound of the probability mass a transition loses to truncation (0 for none/uniform).
+  double cut_mass_bound() const { return cut_mass_bound_; }
+
+  /// Mass of [lo, hi] under the 1-d law of dimension dim with the given mean and scale (a scale of
+  /// 0 is a point mass: 1 when lo <= mean < hi). Exact (erfc), double precision.
+  double interval_mass(std::size_t dim, double lo, double hi, double mean, double scale) const;
+  /// Mass of the cell of grid index k along dim.
+  double cell_mass(std::size_t dim, std::size_t k, double mean, double scale) const;
+
+  /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
+  /// bound documented in noise.cpp and README ("Full covariance"); |error| <= box_mass_tolerance().
+  double box_mass(const double* lo, const double* hi, const double* mean) const;
+  double box_mass_tolerance() const { return box_mass_tolerance_; }
+
+  /// Clipped window for post mean `mean`: first[i]..last[i] (inclusive grid indices). Returns
+  /// false when the window misses the grid in some dimension (all mass leaves the grid).
+  bool window(const Grid& states, const double* mean, std::int64_t* first, std::int64_t* last) const;
+
+  /// Probability T(x'|x,u,w) of the state cell `target` (flat index) for post mean `mean` from
+  /// current state x (used by the reference engine and tests): 0 outside the window.
+  double transition_probability(const Grid& states, std::size_t target, const double* mean,
+                                const double* x) const;
+
+ private:
+  std::size_t dims_ = 0;
+  NoiseType type_ = NoiseType::Additive;
+  Distribution distribution_ = Distribution::Normal;
+  bool separable_ = true;
+  std::vector<double> base_scale_;
+  std::vector<double> covariance_;       // full n*n, row-major
+  std::vector<double> cholesky_;         // lower triangular, row-major (full covariance)
+  std::vector<double> eta_;
+  std::vector<std::int64_t> window_half_cells_;
+  double cut_mass_bound_ = 0.0;
+  double box_mass_tolerance_ = 0.0;
+  std::size_t grid_size_ = 1;
+};
+
+/// Standard normal upper tail quantile: z with 1 - Phi(z) = p, for p in (0, 0.5].
+double normal_upper_quantile(double p);
+
+}  // namespace amytiss

@@ -1,0 +1,54 @@
+#pragma once
+// The synthesized time-varying policy u*(x, k) and the values V_k(x) (SPEC section 2).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/grid.hpp"
+
+namespace amytiss {
+
+/// Outcome of a lookup; every non-Ok status comes with a message from describe().
+enum class LookupStatus { Ok, WrongDimension, NotFinite, OutsideGrid, StepBeyondHorizon };
+
+struct Policy {
+  Grid states;
+  Grid inputs;
+  unsigned horizon = 0;
+  /// V_k for k = 0..horizon, k-major: values[k * states.size() + flat]. Probabilities in [0, 1].
+  std::vector<double> values;
+  /// Index (flat, into `inputs`) of u*(x, k) for k = 0..horizon-1: input_index[k * states.size()
+  /// + flat]. Ties: the lowest flat input index. Cells with a fixed role (target, avoid, unsafe)
+  /// hold input 0.
+  std::vector<std::uint32_t> input_index;
+  std::vector<CellRole> roles;
+  /// What computed it (device name or "reference") and the configuration's hash.
+  std::string computed_by;
+  std::string config_hash;
+
+  double value(unsigned step, std::size_t cell) const { return values[std::size_t(step) * states.size() + cell]; }
+  std::uint32_t input(unsigned step, std::size_t cell) const {
+    return input_index[std::size_t(step) * states.size() + cell];
+  }
+
+  /// Concrete state -> input and probability for time step `step` (0 <= step < horizon).
+  /// Writes inputs.dims() values to input_out and V_step(cell) to probability_out on Ok. No
+  /// allocation, O(dimension).
+  LookupStatus lookup(const double* state, std::size_t state_length, unsigned step,
+                      double* input_out, double* probability_out) const;
+  /// A sentence that says what was wrong and what was expected, e.g. "state has 3 values,
+  /// expected 2 (x0, x1)" or "state [12, 0] is outside the grid [-10.25, 10.25] x [...]".
+  std::string describe(LookupStatus status, const double* state, std::size_t state_length,
+                       unsigned step) const;
+};
+
+/// Summary of V_0 for logs: min, mean, max over Free cells, and how many cells have V_0 >= 0.5.
+struct ValueSummary {
+  double min = 0, mean = 0, max = 0;
+  std::size_t free_cells = 0, cells_at_least_half = 0;
+};
+ValueSummary summarize_initial_values(const Policy& policy);
+
+}  // namespace amytiss
