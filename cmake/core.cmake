@@ -16,7 +16,8 @@ add_custom_command(OUTPUT ${AMYTISS_EMBEDDED_CPP}
   COMMAND ${CMAKE_COMMAND} -DOUT=${AMYTISS_EMBEDDED_CPP} "-DINPUTS=${AMYTISS_EMBEDDED_ARG}"
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/embed.cmake
   DEPENDS ${AMYTISS_EMBEDDED_INPUTS} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/embed.cmake
-  COMMENT "Embedding OpenCL and model sources")
+  COMMENT "Embedding OpenCL and model sources"
+  VERBATIM)
 
 file(GLOB AMYTISS_CORE_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/core/*.cpp)
 add_library(amytiss_core ${AMYTISS_CORE_SOURCES} ${AMYTISS_EMBEDDED_CPP})

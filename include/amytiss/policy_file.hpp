@@ -32,4 +32,11 @@ LoadedPolicy read_policy_file(const std::string& path);
 /// PolicyFileError naming both hashes otherwise.
 LoadedPolicy read_policy_file_for(const std::string& path, const Config& config);
 
+namespace detail {
+/// write_policy_file with a chosen format name and version and without the value checks (values
+/// in [0, 1], input indices in range): only for tests of the reader's refusals.
+void write_policy_file_as(const std::string& path, const Policy& policy, const Config& config,
+                          const std::string& format, unsigned format_version);
+}  // namespace detail
+
 }  // namespace amytiss

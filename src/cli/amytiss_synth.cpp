@@ -1,0 +1,337 @@
+// amytiss_synth: synthesizes a policy from a YAML configuration and writes it as an HDF5 policy
+// file. Usage and sample output: docs/cli.md.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
+#include "amytiss/policy.hpp"
+#include "amytiss/policy_file.hpp"
+
+namespace {
+
+using namespace amytiss;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kUsage =
+    "usage: amytiss_synth --config FILE [options]\n"
+    "\n"
+    "Synthesizes a controller (policy) for the configuration's specification and writes it as\n"
+    "an HDF5 policy file (docs/policy_file.md).\n"
+    "\n"
+    "options:\n"
+    "  --config FILE                      YAML configuration (SPEC section 3)\n"
+    "  --device auto|cpu|gpu|reference    overrides compute.device\n"
+    "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
+    "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
+    "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
+    "  --profile                          per-phase timing, rates and memory table\n"
+    "  --compare-reference                also run the serial reference engine and compare V_0\n"
+    "  --list-devices                     list the OpenCL devices and exit\n"
+    "  --quiet                            no progress lines\n"
+    "  --help                             this text\n"
+    "\n"
+    "exit status: 0 success, 2 bad input (configuration or options), 1 other failures\n";
+
+// Bad command-line input; reported like a configuration error (exit status 2).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string config_path;
+  std::string device;       // empty: the configuration's
+  std::string transitions;  // empty: the configuration's
+  std::string platform;
+  std::string output;
+  bool profile = false;
+  bool compare_reference = false;
+  bool list_devices = false;
+  bool quiet = false;
+  bool help = false;
+};
+
+Options parse_options(int argc, char** argv) {
+  Options options;
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value (see --help)");
+      return args[++i];
+    };
+    if (arg == "--config") options.config_path = value();
+    else if (arg == "--device") options.device = value();
+    else if (arg == "--transitions") options.transitions = value();
+    else if (arg == "--platform") options.platform = value();
+    else if (arg == "--output" || arg == "-o") options.output = value();
+    else if (arg == "--profile") options.profile = true;
+    else if (arg == "--compare-reference") options.compare_reference = true;
+    else if (arg == "--list-devices") options.list_devices = true;
+    else if (arg == "--quiet" || arg == "-q") options.quiet = true;
+    else if (arg == "--help" || arg == "-h") options.help = true;
+    else throw UsageError("unknown option '" + arg + "' (see --help)");
+  }
+  if (!options.help && !options.list_devices && options.config_path.empty())
+    throw UsageError("--config FILE is required (example: --config config/robot_safety.yaml)");
+  return options;
+}
+
+DeviceKind parse_device(const std::string& text) {
+  for (DeviceKind kind : {DeviceKind::Auto, DeviceKind::Cpu, DeviceKind::Gpu, DeviceKind::Reference})
+    if (text == to_string(kind)) return kind;
+  throw UsageError("--device: got '" + text + "', expected auto, cpu, gpu or reference");
+}
+
+TransitionStorage parse_transitions(const std::string& text) {
+  for (TransitionStorage storage :
+       {TransitionStorage::Auto, TransitionStorage::Stored, TransitionStorage::OnTheFly})
+    if (text == to_string(storage)) return storage;
+  throw UsageError("--transitions: got '" + text + "', expected auto, stored or on_the_fly");
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string format_bytes(double bytes) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  std::size_t unit = 0;
+  while (bytes >= 1024.0 && unit + 1 < std::size(units)) {
+    bytes /= 1024.0;
+    ++unit;
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, unit == 0 ? "%.0f %s" : "%.1f %s", bytes, units[unit]);
+  return text;
+}
+
+std::string format_seconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, seconds < 10 ? "%.3f s" : "%.1f s", seconds);
+  return text;
+}
+
+std::string counts_text(const Grid& grid) {
+  if (grid.dims() == 0) return "";
+  std::string text = " (";
+  for (std::size_t dim = 0; dim < grid.dims(); ++dim)
+    text += (dim ? " x " : "") + std::to_string(grid.count(dim));
+  return text + ")";
+}
+
+void print_sizes(const Abstraction& abstraction) {
+  std::printf("grid: states %zu%s, inputs %zu%s, disturbances %zu%s\n",
+              abstraction.states.size(), counts_text(abstraction.states).c_str(),
+              abstraction.inputs.size(), counts_text(abstraction.inputs).c_str(),
+              abstraction.disturbances.size(), counts_text(abstraction.disturbances).c_str());
+  std::printf("state-input pairs: %zu, state-input-disturbance triples: %zu, horizon: %u\n",
+              abstraction.pairs(), abstraction.triples(), abstraction.horizon);
+}
+
+// Bytes of the policy arrays (as in the file) and of stored transitions: per triple, the first
+// index of the window per dimension (int32) and the per-dimension cell masses (float32).
+void print_memory_estimate(const Abstraction& abstraction) {
+  const double cells = double(abstraction.states.size());
+  const double horizon = double(abstraction.horizon);
+  const double policy_bytes = (horizon + 1) * cells * sizeof(double) +
+                              horizon * cells * sizeof(std::uint32_t) + cells;
+  double masses_per_triple = 0;
+  const auto& half_cells = abstraction.noise->window_half_cells();
+  for (std::size_t dim = 0; dim < half_cells.size(); ++dim)
+    masses_per_triple += double(std::min<std::int64_t>(2 * half_cells[dim] + 1,
+                                                       std::int64_t(abstraction.states.count(dim))));
+  const double bytes_per_triple = 4.0 * double(abstraction.states.dims()) + 4.0 * masses_per_triple;
+  std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",
+              format_bytes(policy_bytes).c_str(),
+              format_bytes(bytes_per_triple * double(abstraction.triples())).c_str(),
+              bytes_per_triple);
+}
+
+bool print_progress(const Progress& progress, bool quiet) {
+  if (quiet || progress.phase != "synthesis") return true;
+  std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
+              progress.steps_total, progress.percent(), progress.device.c_str(),
+              format_seconds(progress.elapsed_s).c_str());
+  if (progress.remaining_s >= 0)
+    std::printf(", remaining %s", format_seconds(progress.remaining_s).c_str());
+  std::printf("\n");
+  std::fflush(stdout);
+  return true;
+}
+
+bool is_step_phase(const PhaseReport& phase) { return phase.name.rfind("step", 0) == 0; }
+
+// Construction + synthesis, without device set-up and kernel build (the "compute time").
+double compute_seconds(const SynthesisReport& report) {
+  double total = 0;
+  for (const auto& phase : report.phases)
+    if (phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
+  return total;
+}
+
+// Without --profile the time steps are summed into one line.
+void print_phase_times(const SynthesisReport& report) {
+  double step_seconds = 0;
+  std::size_t steps = 0;
+  for (const auto& phase : report.phases) {
+    if (is_step_phase(phase)) {
+      step_seconds += phase.seconds;
+      ++steps;
+    } else {
+      std::printf("  %-24s %s\n", phase.name.c_str(), format_seconds(phase.seconds).c_str());
+    }
+  }
+  if (steps > 0)
+    std::printf("  %-24s %s\n", ("synthesis (" + std::to_string(steps) + " steps)").c_str(),
+                format_seconds(step_seconds).c_str());
+}
+
+void print_profile(const SynthesisReport& report) {
+  std::printf("profile (%s):\n", report.device.c_str());
+  std::printf("  %-22s %10s %14s %16s %10s\n", "phase", "seconds", "pairs/s", "multiply-adds",
+              "GMAC/s");
+  double total_seconds = 0, total_multiply_adds = 0;
+  for (const auto& phase : report.phases) {
+    total_seconds += phase.seconds;
+    total_multiply_adds += phase.multiply_adds;
+    const double rate = phase.seconds > 0 ? phase.multiply_adds / phase.seconds / 1e9 : 0.0;
+    std::printf("  %-22s %10.4f %14.4g %16.4g %10.3f\n", phase.name.c_str(), phase.seconds,
+                phase.pairs_per_second, phase.multiply_adds, rate);
+  }
+  std::printf("  %-22s %10.4f %14s %16.4g %10.3f\n", "total", total_seconds, "",
+              total_multiply_adds,
+              total_seconds > 0 ? total_multiply_adds / total_seconds / 1e9 : 0.0);
+  std::printf("  device memory: %s, host peak (VmHWM): %s\n",
+              format_bytes(double(report.device_bytes)).c_str(),
+              format_bytes(double(std::max(report.host_peak_bytes, peak_resident_bytes()))).c_str());
+}
+
+void print_value_summary(const Policy& policy) {
+  const ValueSummary summary = summarize_initial_values(policy);
+  std::printf("V_0 over %zu free cells: min %.6f, mean %.6f, max %.6f; %zu cells with V_0 >= 0.5\n",
+              summary.free_cells, summary.min, summary.mean, summary.max,
+              summary.cells_at_least_half);
+}
+
+void compare_with_reference(const Abstraction& abstraction, const Policy& policy,
+                            double engine_seconds, double engine_compute_seconds, bool quiet) {
+  std::printf("reference engine (for comparison):\n");
+  const auto start = Clock::now();
+  SynthesisReport reference_report;
+  const Policy reference = synthesize_reference(
+      abstraction, [quiet](const Progress& progress) { return print_progress(progress, quiet); },
+      &reference_report);
+  const double reference_seconds = seconds_since(start);
+  double max_difference = 0;
+  for (std::size_t cell = 0; cell < policy.states.size(); ++cell)
+    max_difference =
+        std::max(max_difference, std::fabs(policy.value(0, cell) - reference.value(0, cell)));
+  std::printf("  reference time %s; engine %s end to end, %s compute\n",
+              format_seconds(reference_seconds).c_str(), format_seconds(engine_seconds).c_str(),
+              format_seconds(engine_compute_seconds).c_str());
+  std::printf("  speed-up %.1fx end to end, %.1fx compute\n",
+              engine_seconds > 0 ? reference_seconds / engine_seconds : 0.0,
+              engine_compute_seconds > 0 ? reference_seconds / engine_compute_seconds : 0.0);
+  std::printf("  max |dV_0| (engine - reference): %.3g\n", max_difference);
+}
+
+int run(const Options& options) {
+  if (options.help) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  if (options.list_devices) {
+    const auto devices = list_opencl_devices();
+    if (devices.empty()) std::printf("no OpenCL devices found\n");
+    for (const auto& line : devices) std::printf("%s\n", line.c_str());
+    return 0;
+  }
+
+  const auto setup_start = Clock::now();
+  Config config = load_config_file(options.config_path);
+  if (!options.device.empty()) config.compute.device = parse_device(options.device);
+  if (!options.transitions.empty())
+    config.compute.transitions = parse_transitions(options.transitions);
+  if (!options.platform.empty()) config.compute.platform = options.platform;
+  const Abstraction abstraction = Abstraction::from_config(config);
+  const double setup_seconds = seconds_since(setup_start);
+
+  std::printf("configuration: %s (%s, %s), hash %s\n", config.name.c_str(),
+              options.config_path.c_str(), to_string(config.spec.type).c_str(),
+              config_hash(config).c_str());
+  print_sizes(abstraction);
+  print_memory_estimate(abstraction);
+  std::printf("device: %s, transitions: %s\n", to_string(config.compute.device).c_str(),
+              to_string(config.compute.transitions).c_str());
+  std::fflush(stdout);
+
+  SynthesisOptions synthesis_options;
+  synthesis_options.compute = config.compute;
+  synthesis_options.profile = options.profile;
+  const bool quiet = options.quiet;
+  synthesis_options.progress = [quiet](const Progress& progress) {
+    return print_progress(progress, quiet);
+  };
+  SynthesisReport report;
+  const auto synthesis_start = Clock::now();
+  const Policy policy = synthesize(abstraction, synthesis_options, &report);
+  const double synthesis_wall_seconds = seconds_since(synthesis_start);
+  for (const auto& note : report.log) std::printf("note: %s\n", note.c_str());
+  std::printf("computed by %s, transitions %s\n", report.device.c_str(),
+              report.transitions.c_str());
+
+  const std::string output = options.output.empty() ? config.name + ".h5" : options.output;
+  const auto write_start = Clock::now();
+  write_policy_file(output, policy, config);
+  const double write_seconds = seconds_since(write_start);
+
+  std::printf("wall time:\n");
+  std::printf("  %-24s %s\n", "config + abstraction", format_seconds(setup_seconds).c_str());
+  print_phase_times(report);
+  std::printf("  %-24s %s\n", "synthesize() total", format_seconds(synthesis_wall_seconds).c_str());
+  std::printf("  %-24s %s\n", "file write", format_seconds(write_seconds).c_str());
+  if (options.profile) print_profile(report);
+  print_value_summary(policy);
+  if (options.compare_reference) {
+    const double engine_compute_seconds =
+        report.phases.empty() ? synthesis_wall_seconds : compute_seconds(report);
+    compare_with_reference(abstraction, policy, synthesis_wall_seconds, engine_compute_seconds,
+                           quiet);
+  }
+  std::printf("wrote %s\n", output.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parse_options(argc, argv));
+  } catch (const UsageError& error) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 2;
+  } catch (const ConfigError& error) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 2;
+  } catch (const ParseError& error) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 2;
+  } catch (const std::exception& error) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 1;
+  }
+}

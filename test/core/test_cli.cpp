@@ -1,0 +1,216 @@
+// The command-line tool amytiss_synth, run as a process on the tiny configurations of test/data:
+// its output lines, exit codes, the file it writes, and that Python's h5py opens that file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "amytiss/config.hpp"
+#include "amytiss/policy_file.hpp"
+
+namespace amytiss {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSourceDir = AMYTISS_SOURCE_DIR;
+const std::string kSynth = AMYTISS_SYNTH_BIN;
+const std::string kTinyConfig = kSourceDir + "/test/data/cli_tiny.yaml";
+const std::string kBadEtaConfig = kSourceDir + "/test/data/cli_bad_eta.yaml";
+// cli_tiny.yaml: 9 x 9 states, 3 x 3 inputs, horizon 4.
+constexpr std::size_t kTinyStates = 81, kTinyInputs = 9;
+// Two runs of the same engine on the same problem agree exactly.
+constexpr double kSameEngineTolerance = 0.0;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+std::string quote(const std::string& text) { return "'" + text + "'"; }
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = fs::temp_directory_path() /
+                 ("amytiss_cli_test_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(directory_);
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  // Runs `command` in the test's directory with stdout and stderr captured to files.
+  CommandResult run_in_directory(const std::string& command) const {
+    const fs::path out = directory_ / "stdout.txt", err = directory_ / "stderr.txt";
+    const std::string line = "cd " + quote(directory_.string()) + " && " + command + " >" +
+                             quote(out.string()) + " 2>" + quote(err.string());
+    const int status = std::system(line.c_str());
+    CommandResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = read_file(out);
+    result.err = read_file(err);
+    fs::remove(out);
+    fs::remove(err);
+    return result;
+  }
+  CommandResult synth(const std::string& arguments) const {
+    return run_in_directory(quote(kSynth) + " " + arguments);
+  }
+  std::string path(const std::string& name) const { return (directory_ / name).string(); }
+
+  fs::path directory_;
+};
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string::npos, (haystack).find(needle)) << "missing '" << (needle) << "' in:\n" << (haystack)
+
+TEST_F(CliTest, HelpListsEveryOption) {
+  const CommandResult result = synth("--help");
+  EXPECT_EQ(0, result.exit_code) << result.err;
+  for (const char* option : {"--config", "--device", "--transitions", "--platform", "--output",
+                             "--profile", "--compare-reference", "--list-devices", "--quiet"})
+    EXPECT_CONTAINS(result.out, option);
+}
+
+TEST_F(CliTest, SynthesizesTheTinyProblemAndPrintsEachPart) {
+  const CommandResult result =
+      synth("--config " + quote(kTinyConfig) + " --device reference --output tiny.h5");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_EQ("", result.err);
+  EXPECT_CONTAINS(result.out, "grid: states 81 (9 x 9), inputs 9 (3 x 3), disturbances 1");
+  EXPECT_CONTAINS(result.out, "state-input pairs: 729");
+  EXPECT_CONTAINS(result.out, "estimated memory: policy arrays");
+  EXPECT_CONTAINS(result.out, "stored transitions");
+  for (int step = 1; step <= 4; ++step)
+    EXPECT_CONTAINS(result.out, "step " + std::to_string(step) + "/4");
+  EXPECT_CONTAINS(result.out, "on reference");
+  EXPECT_CONTAINS(result.out, "config + abstraction");
+  EXPECT_CONTAINS(result.out, "synthesis (4 steps)");
+  EXPECT_CONTAINS(result.out, "file write");
+  EXPECT_CONTAINS(result.out, "V_0 over");
+  EXPECT_CONTAINS(result.out, "wrote tiny.h5");
+
+  const LoadedPolicy loaded = read_policy_file_for(path("tiny.h5"), load_config_file(kTinyConfig));
+  EXPECT_EQ(kTinyStates, loaded.policy.states.size());
+  EXPECT_EQ(kTinyInputs, loaded.policy.inputs.size());
+  EXPECT_EQ(4u, loaded.policy.horizon);
+  EXPECT_EQ("reference", loaded.policy.computed_by);
+}
+
+TEST_F(CliTest, QuietOmitsTheProgressLines) {
+  const CommandResult result =
+      synth("--config " + quote(kTinyConfig) + " --device reference --quiet");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_EQ(std::string::npos, result.out.find("step 1/4")) << result.out;
+  EXPECT_CONTAINS(result.out, "V_0 over");
+}
+
+TEST_F(CliTest, DefaultOutputIsTheConfigurationNameInTheCurrentDirectory) {
+  const CommandResult result =
+      synth("--config " + quote(kTinyConfig) + " --device reference --quiet");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_TRUE(fs::exists(path("cli_tiny.h5")));
+}
+
+TEST_F(CliTest, ProfilePrintsThePhaseTable) {
+  const CommandResult result =
+      synth("--config " + quote(kTinyConfig) + " --device reference --quiet --profile");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "profile (reference)");
+  EXPECT_CONTAINS(result.out, "GMAC/s");
+  EXPECT_CONTAINS(result.out, "step 0");
+  EXPECT_CONTAINS(result.out, "host peak (VmHWM)");
+}
+
+TEST_F(CliTest, CompareReferencePrintsSpeedUpAndDifference) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) +
+                                     " --device reference --quiet --compare-reference");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "speed-up");
+  const std::string marker = "max |dV_0| (engine - reference): ";
+  const std::size_t at = result.out.find(marker);
+  ASSERT_NE(std::string::npos, at) << result.out;
+  EXPECT_LE(std::stod(result.out.substr(at + marker.size())), kSameEngineTolerance);
+}
+
+TEST_F(CliTest, BadConfigurationExitsTwoNamingTheKey) {
+  const CommandResult result = synth("--config " + quote(kBadEtaConfig));
+  EXPECT_EQ(2, result.exit_code) << result.out << result.err;
+  EXPECT_EQ(0u, result.err.rfind("error: ", 0)) << result.err;
+  EXPECT_CONTAINS(result.err, "states.eta");
+  EXPECT_FALSE(fs::exists(path("cli_bad_eta.h5")));
+}
+
+TEST_F(CliTest, MissingConfigurationFileExitsTwo) {
+  const CommandResult result = synth("--config " + quote(path("absent.yaml")));
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "error: ");
+  EXPECT_CONTAINS(result.err, "absent.yaml");
+}
+
+TEST_F(CliTest, BadOptionsExitTwo) {
+  CommandResult result = synth("--config " + quote(kTinyConfig) + " --device tpu");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "error: --device: got 'tpu'");
+  result = synth("--frobnicate");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "unknown option '--frobnicate'");
+  result = synth("--device reference");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "--config FILE is required");
+}
+
+TEST_F(CliTest, UnwritableOutputExitsOne) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) +
+                                     " --device reference --quiet --output " +
+                                     quote(path("no/such/directory/p.h5")));
+  EXPECT_EQ(1, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.err, "error: cannot write policy file");
+}
+
+TEST_F(CliTest, ListDevicesExitsZero) {
+  const CommandResult result = synth("--list-devices");
+  EXPECT_EQ(0, result.exit_code) << result.err;
+  EXPECT_FALSE(result.out.empty());
+}
+
+TEST_F(CliTest, PythonH5pyOpensTheFileWithTheDocumentedLayout) {
+  ASSERT_EQ(0, synth("--config " + quote(kTinyConfig) + " --device reference --quiet "
+                     "--output tiny.h5").exit_code);
+  const CommandResult result = run_in_directory(
+      "/usr/bin/python3 " + quote(kSourceDir + "/scripts/inspect_policy.py") + " tiny.h5");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "attribute format = amytiss-policy");
+  EXPECT_CONTAINS(result.out, "attribute format_version = 1");
+  EXPECT_CONTAINS(result.out,
+                  "attribute config_hash = " + config_hash(load_config_file(kTinyConfig)));
+  EXPECT_CONTAINS(result.out, "attribute horizon = 4");
+  EXPECT_CONTAINS(result.out, "attribute spec = reach_avoid");
+  EXPECT_CONTAINS(result.out, "dataset /config string ()");
+  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9)");
+  EXPECT_CONTAINS(result.out, "dataset /input_index uint32 (4, 9, 9)");
+  EXPECT_CONTAINS(result.out, "dataset /input_values float64 (9, 2)");
+  EXPECT_CONTAINS(result.out, "dataset /roles uint8 (9, 9)");
+  for (const char* grid : {"states", "inputs"}) {
+    EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/lb float64 (2,)");
+    EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/eta float64 (2,)");
+    EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/counts uint64 (2,)");
+  }
+  EXPECT_CONTAINS(result.out, "config first line: ");
+}
+
+}  // namespace
+}  // namespace amytiss

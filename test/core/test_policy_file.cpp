@@ -1,0 +1,276 @@
+// Policy files: exact round trip and every refusal of the reader, each with its message.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+
+#include "amytiss/config.hpp"
+#include "amytiss/errors.hpp"
+#include "amytiss/policy_file.hpp"
+
+namespace amytiss {
+namespace {
+
+namespace fs = std::filesystem;
+
+Config tiny_config() {
+  Config config;
+  config.name = "policy_file_test";
+  config.states = GridSpec{{-1.0, 0.0}, {1.0, 1.5}, {0.5, 0.5}};  // 5 x 4 cells
+  config.inputs = GridSpec{{-1.0}, {1.0}, {1.0}};                 // 3 inputs
+  config.dynamics = {"x0 + 0.1*u0", "x1"};
+  config.noise.covariance = {0.1, 0.1};
+  config.spec.type = SpecType::Safety;
+  config.spec.horizon = 3;
+  return config;
+}
+
+// A hand-made policy with values that are not round in binary, so an inexact write shows.
+Policy tiny_policy(const Config& config) {
+  Policy policy;
+  policy.states = Grid(config.states);
+  policy.inputs = config.inputs ? Grid(*config.inputs) : Grid();
+  policy.horizon = config.spec.horizon;
+  const std::size_t cells = policy.states.size();
+  for (std::size_t step = 0; step <= policy.horizon; ++step)
+    for (std::size_t cell = 0; cell < cells; ++cell)
+      policy.values.push_back(std::fmod(0.1 * double(step) + std::sqrt(double(cell) / 7.0), 1.0));
+  for (std::size_t step = 0; step < policy.horizon; ++step)
+    for (std::size_t cell = 0; cell < cells; ++cell)
+      policy.input_index.push_back(std::uint32_t((cell + step) % policy.inputs.size()));
+  for (std::size_t cell = 0; cell < cells; ++cell)
+    policy.roles.push_back(CellRole(cell % 3));
+  policy.computed_by = "hand-made (test)";
+  policy.config_hash = config_hash(config);
+  return policy;
+}
+
+class PolicyFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = fs::temp_directory_path() /
+                 ("amytiss_policy_file_test_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(directory_);
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+  std::string path(const std::string& name) const { return (directory_ / name).string(); }
+
+  fs::path directory_;
+};
+
+// Runs `action` and returns the PolicyFileError message; fails the test when none is thrown.
+template <typename Action>
+std::string refusal(Action action) {
+  try {
+    action();
+  } catch (const PolicyFileError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "no PolicyFileError was thrown";
+  return "";
+}
+
+void expect_same_grid(const Grid& expected, const Grid& actual) {
+  EXPECT_EQ(expected.lb(), actual.lb());
+  EXPECT_EQ(expected.eta(), actual.eta());
+  EXPECT_EQ(expected.counts(), actual.counts());
+  EXPECT_EQ(expected.size(), actual.size());
+}
+
+void expect_same_policy(const Policy& expected, const Policy& actual) {
+  expect_same_grid(expected.states, actual.states);
+  expect_same_grid(expected.inputs, actual.inputs);
+  EXPECT_EQ(expected.horizon, actual.horizon);
+  EXPECT_EQ(expected.values, actual.values);  // bit-exact: float64 is stored as float64
+  EXPECT_EQ(expected.input_index, actual.input_index);
+  EXPECT_EQ(expected.roles, actual.roles);
+  EXPECT_EQ(expected.computed_by, actual.computed_by);
+  EXPECT_EQ(expected.config_hash, actual.config_hash);
+}
+
+TEST_F(PolicyFileTest, RoundTripGivesAnIdenticalPolicy) {
+  const Config config = tiny_config();
+  const Policy policy = tiny_policy(config);
+  write_policy_file(path("p.h5"), policy, config);
+  const LoadedPolicy loaded = read_policy_file(path("p.h5"));
+  expect_same_policy(policy, loaded.policy);
+  EXPECT_EQ(config_hash(config), loaded.config_hash);
+  EXPECT_EQ(to_yaml(config), loaded.config_yaml);
+  // No temporary file is left next to the result.
+  EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+}
+
+TEST_F(PolicyFileTest, RoundTripOfAnAutonomousSystem) {
+  Config config = tiny_config();
+  config.inputs.reset();
+  config.dynamics = {"0.8*x0", "x1"};
+  Policy policy = tiny_policy(config);
+  std::fill(policy.input_index.begin(), policy.input_index.end(), 0u);
+  write_policy_file(path("autonomous.h5"), policy, config);
+  const LoadedPolicy loaded = read_policy_file(path("autonomous.h5"));
+  EXPECT_EQ(0u, loaded.policy.inputs.dims());
+  EXPECT_EQ(1u, loaded.policy.inputs.size());
+  expect_same_policy(policy, loaded.policy);
+}
+
+TEST_F(PolicyFileTest, OverwritesAnExistingFile) {
+  const Config config = tiny_config();
+  Policy policy = tiny_policy(config);
+  write_policy_file(path("p.h5"), policy, config);
+  policy.values[0] = 0.25;
+  write_policy_file(path("p.h5"), policy, config);
+  EXPECT_EQ(0.25, read_policy_file(path("p.h5")).policy.values[0]);
+}
+
+TEST_F(PolicyFileTest, ReadForTheSameConfigurationAccepts) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  EXPECT_EQ(config_hash(config), read_policy_file_for(path("p.h5"), config).config_hash);
+}
+
+TEST_F(PolicyFileTest, RefusesAFileOfAnotherConfigurationNamingBothHashes) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  Config other = config;
+  other.noise.covariance = {0.2, 0.1};
+  ASSERT_NE(config_hash(config), config_hash(other));
+  const std::string message = refusal([&] { read_policy_file_for(path("p.h5"), other); });
+  EXPECT_NE(std::string::npos, message.find("another configuration")) << message;
+  EXPECT_NE(std::string::npos, message.find(config_hash(config))) << message;
+  EXPECT_NE(std::string::npos, message.find(config_hash(other))) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesAMissingFile) {
+  const std::string message = refusal([&] { read_policy_file(path("absent.h5")); });
+  EXPECT_NE(std::string::npos, message.find("does not exist")) << message;
+  EXPECT_NE(std::string::npos, message.find("absent.h5")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesATruncatedFile) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  fs::resize_file(path("p.h5"), fs::file_size(path("p.h5")) / 2);
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("truncated or corrupt")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesCorruptBytes) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  {
+    // Overwrite the superblock (signature and addresses) with garbage.
+    std::fstream file(path("p.h5"), std::ios::in | std::ios::out | std::ios::binary);
+    const std::string garbage(64, '\x5a');
+    file.write(garbage.data(), std::streamsize(garbage.size()));
+  }
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("truncated or corrupt")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesAFileThatIsNotHdf5) {
+  std::ofstream(path("text.h5")) << "name: not a policy\n";
+  const std::string message = refusal([&] { read_policy_file(path("text.h5")); });
+  EXPECT_NE(std::string::npos, message.find("truncated or corrupt")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesAnotherFormat) {
+  const Config config = tiny_config();
+  detail::write_policy_file_as(path("p.h5"), tiny_policy(config), config, "someone-else", 1);
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("not an amytiss policy")) << message;
+  EXPECT_NE(std::string::npos, message.find("someone-else")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesAnotherFormatVersion) {
+  const Config config = tiny_config();
+  detail::write_policy_file_as(path("p.h5"), tiny_policy(config), config, "amytiss-policy", 2);
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("format_version 2 is not supported")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesValuesOutsideTheUnitIntervalOrNaN) {
+  const Config config = tiny_config();
+  for (double bad : {1.5, -0.25, std::numeric_limits<double>::quiet_NaN()}) {
+    Policy policy = tiny_policy(config);
+    policy.values[7] = bad;
+    EXPECT_THROW(write_policy_file(path("p.h5"), policy, config), PolicyFileError);
+    detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", 1);
+    const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+    EXPECT_NE(std::string::npos, message.find("'/values' element 7")) << message;
+    EXPECT_NE(std::string::npos, message.find("[0, 1]")) << message;
+  }
+}
+
+TEST_F(PolicyFileTest, RefusesAnInputIndexOutOfRange) {
+  const Config config = tiny_config();
+  Policy policy = tiny_policy(config);
+  policy.input_index[4] = 3;  // the input grid has 3 points
+  EXPECT_THROW(write_policy_file(path("p.h5"), policy, config), PolicyFileError);
+  detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", 1);
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("'/input_index' element 4 is 3")) << message;
+}
+
+TEST_F(PolicyFileTest, RefusesArraysWhoseShapeDisagreesWithTheGrid) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  // Patch the dataspace of /values from (4, 5, 4) to (3, 5, 4): the file stays readable, the
+  // shape no longer matches (horizon+1, n0, n1).
+  std::string bytes;
+  {
+    std::ifstream file(path("p.h5"), std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+  }
+  const std::string shape("\x04\0\0\0\0\0\0\0\x05\0\0\0\0\0\0\0\x04\0\0\0\0\0\0\0", 24);
+  // The dataspace message stores the dimensions and the maximum dimensions (HDF5 may keep more
+  // copies); patch every occurrence.
+  std::size_t patched = 0;
+  for (std::size_t at = bytes.find(shape); at != std::string::npos; at = bytes.find(shape, at + 1)) {
+    bytes[at] = '\x03';
+    ++patched;
+  }
+  ASSERT_GE(patched, 1u);
+  std::ofstream(path("p.h5"), std::ios::binary | std::ios::trunc) << bytes;
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("'/values' has shape (3, 5, 4), expected (4, 5, 4)"))
+      << message;
+}
+
+TEST_F(PolicyFileTest, WriterRefusesArraysOfTheWrongSizeAndLeavesNoFile) {
+  const Config config = tiny_config();
+  Policy policy = tiny_policy(config);
+  policy.values.pop_back();
+  const std::string message = refusal([&] { write_policy_file(path("p.h5"), policy, config); });
+  EXPECT_NE(std::string::npos, message.find("(horizon+1)*cells")) << message;
+  EXPECT_TRUE(fs::is_empty(directory_));
+}
+
+TEST_F(PolicyFileTest, FailedWriteLeavesNoTemporaryFile) {
+  const Config config = tiny_config();
+  // The target is an existing directory: creating the temporary works, the rename cannot.
+  fs::create_directories(path("occupied.h5/inside"));
+  const std::string message =
+      refusal([&] { write_policy_file(path("occupied.h5"), tiny_policy(config), config); });
+  EXPECT_NE(std::string::npos, message.find("cannot write policy file")) << message;
+  EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+}
+
+TEST_F(PolicyFileTest, RefusesAPolicyOfAnotherConfigurationAtWriteTime) {
+  const Config config = tiny_config();
+  Policy policy = tiny_policy(config);
+  policy.config_hash = "0123456789abcdef";
+  const std::string message = refusal([&] { write_policy_file(path("p.h5"), policy, config); });
+  EXPECT_NE(std::string::npos, message.find("0123456789abcdef")) << message;
+  EXPECT_TRUE(fs::is_empty(directory_));
+}
+
+}  // namespace
+}  // namespace amytiss
