@@ -36,7 +36,7 @@ struct NoiseConfig {
   std::vector<double> covariance;
   /// uniform: half-width of the support per dimension (noise uniform on [-h, h]).
   std::vector<double> half_width;
-  Truncation truncation = Truncation::CuttingProbability;
+  Truncation truncation = Truncation::None;  ///< default: nothing cut (exact)
   /// cutting_probability: total probability mass that may be cut per transition, in (0, 1).
   double cutting_probability = 1e-3;
   /// fixed_region: half-widths of the kept box around the post mean, per dimension (state units).

@@ -1,0 +1,501 @@
+#include "amytiss/expression.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "amytiss/errors.hpp"
+
+namespace amytiss {
+
+enum class NodeKind { Number, Variable, Unary, Binary, Call, Conditional };
+enum class VariableSpace { State, Input, Disturbance };
+
+struct ExpressionNode {
+  NodeKind kind = NodeKind::Number;
+  double number = 0.0;
+  VariableSpace space = VariableSpace::State;
+  std::size_t index = 0;
+  std::string op;  // operator symbol (unary/binary) or function name (call)
+  std::vector<std::shared_ptr<const ExpressionNode>> children;
+};
+
+namespace {
+
+using NodePtr = std::shared_ptr<const ExpressionNode>;
+
+struct FunctionInfo {
+  const char* name;
+  std::size_t arity;
+  const char* c_name;
+};
+
+const FunctionInfo kFunctions[] = {
+    {"sin", 1, "sin"},     {"cos", 1, "cos"},     {"tan", 1, "tan"},     {"asin", 1, "asin"},
+    {"acos", 1, "acos"},   {"atan", 1, "atan"},   {"atan2", 2, "atan2"}, {"exp", 1, "exp"},
+    {"log", 1, "log"},     {"sqrt", 1, "sqrt"},   {"pow", 2, "pow"},     {"abs", 1, "fabs"},
+    {"min", 2, "fmin"},    {"max", 2, "fmax"},    {"floor", 1, "floor"}, {"ceil", 1, "ceil"},
+    {"if", 3, nullptr},
+};
+
+const FunctionInfo* find_function(const std::string& name) {
+  for (const auto& info : kFunctions)
+    if (name == info.name) return &info;
+  return nullptr;
+}
+
+std::string function_list() {
+  std::string list;
+  for (const auto& info : kFunctions) {
+    if (!list.empty()) list += ", ";
+    list += info.name;
+  }
+  return list;
+}
+
+enum class TokenKind { Number, Identifier, Operator, Invalid, End };
+
+struct Token {
+  TokenKind kind = TokenKind::End;
+  std::string text;
+  double number = 0.0;
+  std::size_t column = 0;  // 1-based
+};
+
+std::string describe(const Token& token) {
+  switch (token.kind) {
+    case TokenKind::End: return "the end of the expression";
+    case TokenKind::Number: return "number " + token.text;
+    case TokenKind::Identifier: return "'" + token.text + "'";
+    default: return "'" + token.text + "'";
+  }
+}
+
+std::vector<Token> tokenize(const std::string& text) {
+  std::vector<Token> tokens;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
+      continue;
+    }
+    Token token;
+    token.column = i + 1;
+    if (std::isdigit(static_cast<unsigned char>(c)) ||
+        (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
+      std::size_t j = i;
+      while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+      if (j < text.size() && text[j] == '.') {
+        ++j;
+        while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+      }
+      if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
+        std::size_t k = j + 1;
+        if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
+        if (k >= text.size() || !std::isdigit(static_cast<unsigned char>(text[k])))
+          throw ParseError(k + 1, "expected digits of the exponent in number '" +
+                                      text.substr(i, k - i) + "'");
+        while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+        j = k;
+      }
+      token.kind = TokenKind::Number;
+      token.text = text.substr(i, j - i);
+      token.number = std::strtod(token.text.c_str(), nullptr);
+      if (!std::isfinite(token.number))
+        throw ParseError(token.column, "number " + token.text + " is out of the double range");
+      i = j;
+    } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      std::size_t j = i;
+      while (j < text.size() && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
+      token.kind = TokenKind::Identifier;
+      token.text = text.substr(i, j - i);
+      i = j;
+    } else {
+      static const char* const kTwoCharOperators[] = {"<=", ">=", "==", "!=", "&&", "||"};
+      token.kind = TokenKind::Operator;
+      for (const char* op : kTwoCharOperators)
+        if (text.compare(i, 2, op) == 0) token.text = op;
+      if (token.text.empty()) {
+        if (std::string("+-*/^()<>,?:!").find(c) == std::string::npos) {
+          std::string hint;
+          if (c == '=') hint = " (did you mean '=='?)";
+          if (c == '&') hint = " (did you mean '&&'?)";
+          if (c == '|') hint = " (did you mean '||'?)";
+          // Reported only when the parser reaches it, so earlier errors come first.
+          token.kind = TokenKind::Invalid;
+          token.text = "unexpected character '" + std::string(1, c) + "'" + hint;
+          tokens.push_back(token);
+          ++i;
+          continue;
+        }
+        token.text = std::string(1, c);
+      }
+      i += token.text.size();
+    }
+    tokens.push_back(token);
+  }
+  Token end;
+  end.column = text.size() + 1;
+  tokens.push_back(end);
+  return tokens;
+}
+
+NodePtr make_number(double value) {
+  auto node = std::make_shared<ExpressionNode>();
+  node->kind = NodeKind::Number;
+  node->number = value;
+  return node;
+}
+
+NodePtr make_operator(NodeKind kind, const std::string& op, std::vector<NodePtr> children) {
+  auto node = std::make_shared<ExpressionNode>();
+  node->kind = kind;
+  node->op = op;
+  node->children = std::move(children);
+  return node;
+}
+
+class Parser {
+ public:
+  Parser(const std::string& text, const std::map<std::string, double>& constants, std::size_t state_dims,
+         std::size_t input_dims, std::size_t disturbance_dims)
+      : tokens_(tokenize(text)), constants_(constants),
+        dims_{state_dims, input_dims, disturbance_dims} {}
+
+  NodePtr parse_all() {
+    NodePtr root = parse_expr();
+    if (peek().kind != TokenKind::End)
+      throw ParseError(peek().column,
+                       "expected an operator or the end of the expression, got " + describe(peek()));
+    return root;
+  }
+
+ private:
+  const Token& peek() const {
+    const Token& token = tokens_[position_];
+    if (token.kind == TokenKind::Invalid) throw ParseError(token.column, token.text);
+    return token;
+  }
+  bool peek_operator(const char* op) const {
+    return peek().kind == TokenKind::Operator && peek().text == op;
+  }
+  Token next() {
+    const Token token = peek();
+    ++position_;
+    return token;
+  }
+
+  NodePtr parse_expr() { return parse_conditional(); }
+
+  NodePtr parse_conditional() {
+    NodePtr condition = parse_or();
+    if (!peek_operator("?")) return condition;
+    const Token question = next();
+    NodePtr when_true = parse_expr();
+    if (!peek_operator(":"))
+      throw ParseError(peek().column, "expected ':' of the conditional '?' at column " +
+                                          std::to_string(question.column) + ", got " + describe(peek()));
+    next();
+    NodePtr when_false = parse_expr();
+    return make_operator(NodeKind::Conditional, "?", {condition, when_true, when_false});
+  }
+
+  NodePtr parse_or() {
+    NodePtr left = parse_and();
+    while (peek_operator("||")) {
+      next();
+      left = make_operator(NodeKind::Binary, "||", {left, parse_and()});
+    }
+    return left;
+  }
+
+  NodePtr parse_and() {
+    NodePtr left = parse_comparison();
+    while (peek_operator("&&")) {
+      next();
+      left = make_operator(NodeKind::Binary, "&&", {left, parse_comparison()});
+    }
+    return left;
+  }
+
+  NodePtr parse_comparison() {
+    NodePtr left = parse_sum();
+    for (const char* op : {"<", "<=", ">", ">=", "==", "!="}) {
+      if (peek_operator(op)) {
+        next();
+        NodePtr right = parse_sum();
+        for (const char* again : {"<", "<=", ">", ">=", "==", "!="})
+          if (peek_operator(again))
+            throw ParseError(peek().column, "comparisons cannot be chained; use '&&' (got " +
+                                                describe(peek()) + ")");
+        return make_operator(NodeKind::Binary, op, {left, right});
+      }
+    }
+    return left;
+  }
+
+  NodePtr parse_sum() {
+    NodePtr left = parse_product();
+    while (peek_operator("+") || peek_operator("-")) {
+      const std::string op = next().text;
+      left = make_operator(NodeKind::Binary, op, {left, parse_product()});
+    }
+    return left;
+  }
+
+  NodePtr parse_product() {
+    NodePtr left = parse_unary();
+    while (peek_operator("*") || peek_operator("/")) {
+      const std::string op = next().text;
+      left = make_operator(NodeKind::Binary, op, {left, parse_unary()});
+    }
+    return left;
+  }
+
+  NodePtr parse_unary() {
+    if (peek_operator("-") || peek_operator("+") || peek_operator("!")) {
+      const std::string op = next().text;
+      NodePtr operand = parse_unary();
+      if (op == "+") return operand;
+      return make_operator(NodeKind::Unary, op, {operand});
+    }
+    return parse_power();
+  }
+
+  NodePtr parse_power() {
+    NodePtr base = parse_atom();
+    if (!peek_operator("^")) return base;
+    next();
+    return make_operator(NodeKind::Binary, "^", {base, parse_unary()});
+  }
+
+  NodePtr parse_atom() {
+    const Token token = next();
+    if (token.kind == TokenKind::Number) return make_number(token.number);
+    if (token.kind == TokenKind::Operator && token.text == "(") {
+      NodePtr inner = parse_expr();
+      if (!peek_operator(")"))
+        throw ParseError(peek().column, "expected ')' to close '(' at column " +
+                                            std::to_string(token.column) + ", got " + describe(peek()));
+      next();
+      return inner;
+    }
+    if (token.kind == TokenKind::Identifier) return parse_identifier(token);
+    throw ParseError(token.column,
+                     "expected a number, a variable (x0, u0, w0, ...), a constant, a function or '(', got " +
+                         describe(token));
+  }
+
+  NodePtr parse_identifier(const Token& token) {
+    const std::string& name = token.text;
+    if (const FunctionInfo* function = find_function(name)) return parse_call(token, *function);
+    if (auto variable = parse_variable(token)) return variable;
+    const auto constant = constants_.find(name);
+    if (constant != constants_.end()) return make_number(constant->second);
+    if (name == "pi") return make_number(M_PI);
+    std::string known_constants = "pi";
+    for (const auto& entry : constants_) known_constants += ", " + entry.first;
+    throw ParseError(token.column, "unknown name '" + name + "': expected a variable (" + variable_ranges() +
+                                       "), a constant (" + known_constants + ") or a function (" +
+                                       function_list() + ")");
+  }
+
+  std::string variable_ranges() const {
+    static const char kLetters[] = {'x', 'u', 'w'};
+    std::string ranges;
+    for (int space = 0; space < 3; ++space) {
+      if (dims_[space] == 0) continue;
+      if (!ranges.empty()) ranges += ", ";
+      ranges += std::string(1, kLetters[space]) + "0";
+      if (dims_[space] > 1) ranges += ".." + std::string(1, kLetters[space]) + std::to_string(dims_[space] - 1);
+    }
+    return ranges.empty() ? "none" : ranges;
+  }
+
+  NodePtr parse_variable(const Token& token) {
+    const std::string& name = token.text;
+    if (name.size() < 2) return nullptr;
+    const std::string letters = "xuw";
+    const auto space = letters.find(name[0]);
+    if (space == std::string::npos) return nullptr;
+    for (std::size_t i = 1; i < name.size(); ++i)
+      if (!std::isdigit(static_cast<unsigned char>(name[i]))) return nullptr;
+    if (name.size() > 12)
+      throw ParseError(token.column, "variable index of '" + name + "' is too large");
+    const std::size_t index = std::stoull(name.substr(1));
+    static const char* const kSpaceNames[] = {"state", "input", "disturbance"};
+    if (index >= dims_[space]) {
+      std::string have = dims_[space] == 0
+                             ? std::string("no ") + kSpaceNames[space] + " components"
+                             : std::to_string(dims_[space]) + " " + kSpaceNames[space] +
+                                   (dims_[space] == 1 ? " component" : " components");
+      throw ParseError(token.column, "'" + name + "' is out of range: the system has " + have +
+                                         " (valid: " + variable_ranges() + ")");
+    }
+    auto node = std::make_shared<ExpressionNode>();
+    node->kind = NodeKind::Variable;
+    node->space = static_cast<VariableSpace>(space);
+    node->index = index;
+    return node;
+  }
+
+  NodePtr parse_call(const Token& name, const FunctionInfo& function) {
+    if (!peek_operator("("))
+      throw ParseError(peek().column, "expected '(' after function name " + name.text + ", got " +
+                                          describe(peek()));
+    next();
+    std::vector<NodePtr> arguments;
+    arguments.push_back(parse_expr());
+    while (peek_operator(",")) {
+      next();
+      arguments.push_back(parse_expr());
+    }
+    if (!peek_operator(")")) {
+      if (arguments.size() < function.arity)
+        throw ParseError(peek().column, "expected ',' and the next argument of " + name.text + " (it takes " +
+                                            std::to_string(function.arity) + "), got " + describe(peek()));
+      throw ParseError(peek().column, "expected ')' after argument list of " + name.text + ", got " +
+                                          describe(peek()));
+    }
+    next();
+    if (arguments.size() != function.arity)
+      throw ParseError(name.column, name.text + " takes " + std::to_string(function.arity) +
+                                        (function.arity == 1 ? " argument" : " arguments") + ", got " +
+                                        std::to_string(arguments.size()));
+    if (name.text == "if") return make_operator(NodeKind::Conditional, "?", std::move(arguments));
+    return make_operator(NodeKind::Call, name.text, std::move(arguments));
+  }
+
+  std::vector<Token> tokens_;
+  std::size_t position_ = 0;
+  const std::map<std::string, double>& constants_;
+  std::size_t dims_[3];
+};
+
+double evaluate_node(const ExpressionNode& node, const double* x, const double* u, const double* w) {
+  switch (node.kind) {
+    case NodeKind::Number: return node.number;
+    case NodeKind::Variable:
+      switch (node.space) {
+        case VariableSpace::State: return x[node.index];
+        case VariableSpace::Input: return u[node.index];
+        case VariableSpace::Disturbance: return w[node.index];
+      }
+      return 0.0;
+    case NodeKind::Unary: {
+      const double operand = evaluate_node(*node.children[0], x, u, w);
+      return node.op == "-" ? -operand : (operand == 0.0 ? 1.0 : 0.0);
+    }
+    case NodeKind::Conditional:
+      return evaluate_node(*node.children[0], x, u, w) != 0.0 ? evaluate_node(*node.children[1], x, u, w)
+                                                               : evaluate_node(*node.children[2], x, u, w);
+    case NodeKind::Binary: {
+      const std::string& op = node.op;
+      const double left = evaluate_node(*node.children[0], x, u, w);
+      if (op == "&&") return (left != 0.0 && evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
+      if (op == "||") return (left != 0.0 || evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
+      const double right = evaluate_node(*node.children[1], x, u, w);
+      if (op == "+") return left + right;
+      if (op == "-") return left - right;
+      if (op == "*") return left * right;
+      if (op == "/") return left / right;
+      if (op == "^") return std::pow(left, right);
+      if (op == "<") return left < right ? 1.0 : 0.0;
+      if (op == "<=") return left <= right ? 1.0 : 0.0;
+      if (op == ">") return left > right ? 1.0 : 0.0;
+      if (op == ">=") return left >= right ? 1.0 : 0.0;
+      if (op == "==") return left == right ? 1.0 : 0.0;
+      if (op == "!=") return left != right ? 1.0 : 0.0;
+      return 0.0;
+    }
+    case NodeKind::Call: {
+      const std::string& f = node.op;
+      const double a = evaluate_node(*node.children[0], x, u, w);
+      if (f == "sin") return std::sin(a);
+      if (f == "cos") return std::cos(a);
+      if (f == "tan") return std::tan(a);
+      if (f == "asin") return std::asin(a);
+      if (f == "acos") return std::acos(a);
+      if (f == "atan") return std::atan(a);
+      if (f == "exp") return std::exp(a);
+      if (f == "log") return std::log(a);
+      if (f == "sqrt") return std::sqrt(a);
+      if (f == "abs") return std::fabs(a);
+      if (f == "floor") return std::floor(a);
+      if (f == "ceil") return std::ceil(a);
+      const double b = evaluate_node(*node.children[1], x, u, w);
+      if (f == "atan2") return std::atan2(a, b);
+      if (f == "pow") return std::pow(a, b);
+      if (f == "min") return std::fmin(a, b);
+      if (f == "max") return std::fmax(a, b);
+      return 0.0;
+    }
+  }
+  return 0.0;
+}
+
+std::string c_number(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  std::string text = buffer;
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  if (value < 0) text = "(" + text + ")";
+  return text;
+}
+
+std::string to_c_node(const ExpressionNode& node) {
+  switch (node.kind) {
+    case NodeKind::Number: return c_number(node.number);
+    case NodeKind::Variable: {
+      static const char kNames[] = {'x', 'u', 'w'};
+      return std::string(1, kNames[static_cast<int>(node.space)]) + "[" + std::to_string(node.index) + "]";
+    }
+    case NodeKind::Unary:
+      if (node.op == "-") return "(-" + to_c_node(*node.children[0]) + ")";
+      return "((double)(" + to_c_node(*node.children[0]) + " == 0.0))";
+    case NodeKind::Conditional:
+      return "((" + to_c_node(*node.children[0]) + " != 0.0) ? " + to_c_node(*node.children[1]) + " : " +
+             to_c_node(*node.children[2]) + ")";
+    case NodeKind::Binary: {
+      const std::string left = to_c_node(*node.children[0]);
+      const std::string right = to_c_node(*node.children[1]);
+      const std::string& op = node.op;
+      if (op == "^") return "pow(" + left + ", " + right + ")";
+      if (op == "&&" || op == "||")
+        return "((double)((" + left + " != 0.0) " + op + " (" + right + " != 0.0)))";
+      if (op == "+" || op == "-" || op == "*" || op == "/") return "(" + left + " " + op + " " + right + ")";
+      return "((double)(" + left + " " + op + " " + right + "))";
+    }
+    case NodeKind::Call: {
+      const FunctionInfo* function = find_function(node.op);
+      std::string text = std::string(function->c_name) + "(";
+      for (std::size_t i = 0; i < node.children.size(); ++i) {
+        if (i) text += ", ";
+        text += to_c_node(*node.children[i]);
+      }
+      return text + ")";
+    }
+  }
+  return "0.0";
+}
+
+}  // namespace
+
+Expression Expression::parse(const std::string& text, const std::map<std::string, double>& constants,
+                             std::size_t state_dims, std::size_t input_dims, std::size_t disturbance_dims) {
+  Parser parser(text, constants, state_dims, input_dims, disturbance_dims);
+  Expression expression;
+  expression.root_ = parser.parse_all();
+  expression.text_ = text;
+  return expression;
+}
+
+double Expression::evaluate(const double* x, const double* u, const double* w) const {
+  return evaluate_node(*root_, x, u, w);
+}
+
+std::string Expression::to_c() const { return to_c_node(*root_); }
+
+}  // namespace amytiss
