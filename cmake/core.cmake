@@ -51,6 +51,8 @@ file(GLOB AMYTISS_CORE_TESTS CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test/
 if(AMYTISS_CORE_TESTS)
   if(AMYTISS_WITH_ROS)
     catkin_add_gtest(amytiss_core_tests ${AMYTISS_CORE_TESTS})
+    # Debian's catkin_add_gtest links gtest but not its main().
+    target_link_libraries(amytiss_core_tests gtest_main)
   else()
     enable_testing()
     find_package(GTest REQUIRED)

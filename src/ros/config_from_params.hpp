@@ -1,0 +1,33 @@
+#pragma once
+// ROS parameters -> amytiss::Config. The synthesizer's private namespace holds the YAML schema of
+// SPEC section 3 (loaded with <rosparam command="load">) plus a few node keys (kNodeParameterKeys)
+// that are not part of the configuration.
+#include <string>
+#include <vector>
+
+#include <XmlRpcValue.h>
+#include <yaml-cpp/yaml.h>
+
+#include "amytiss/config.hpp"
+
+namespace amytiss_ros {
+
+/// Private parameters of the synthesizer that are not configuration keys.
+extern const std::vector<std::string> kNodeParameterKeys;
+
+/// The XmlRpc tree as YAML: struct -> map, array -> sequence, int/double/bool/string -> scalars
+/// (doubles with full precision). Throws amytiss::ConfigError (key "<path>") for XmlRpc types
+/// with no YAML counterpart (date-time, base64).
+YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path = "");
+
+/// Converts the private-namespace tree (a struct) to a validated configuration: drops
+/// kNodeParameterKeys, applies `device_override` to compute.device when it is not empty
+/// ("auto", "cpu", "gpu", "reference"), then amytiss::config_from_yaml. Throws ConfigError.
+amytiss::Config config_from_params(XmlRpc::XmlRpcValue& private_params,
+                                   const std::string& device_override = "");
+
+/// The same from YAML text (the Synthesize action's config_yaml). Throws ConfigError, also for
+/// text that is not YAML (key "config_yaml", with the line and column).
+amytiss::Config config_from_yaml_text(const std::string& text, const std::string& device_override = "");
+
+}  // namespace amytiss_ros

@@ -1,0 +1,44 @@
+#pragma once
+// Conversions between core types and amytiss messages. Pure functions: no node, no master.
+#include <string>
+
+#include <amytiss/GetInput.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/PolicyStatus.h>
+#include <amytiss/StateStamped.h>
+#include <amytiss/SynthesizeFeedback.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/policy.hpp"
+
+namespace amytiss_ros {
+
+/// Answers a GetInput request from `policy` (nullptr: no policy loaded yet, answered with
+/// success false and "no policy yet: " + no_policy_reason). On success `input` has the policy's
+/// input dimensions and `probability` is V_k of the state's cell; otherwise success is false,
+/// `message` is Policy::describe()'s sentence, `input` is empty and probability 0.
+/// Allocation: only the response's input vector (reuses its capacity).
+void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
+                             unsigned time_step, const std::string& no_policy_reason,
+                             amytiss::GetInput::Response& response);
+
+/// The same for the closed loop: answers `state` into `command` (header and time_step copied).
+void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
+                        const std::string& no_policy_reason, amytiss::InputCommand& command);
+
+/// Action feedback from engine progress.
+amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
+
+/// "synthesis 42% (step 7/16) on reference, about 3.1 s left" for status and logs.
+std::string describe_progress(const amytiss::Progress& progress);
+
+/// Latched RViz markers over the x0/x1 projection (x1 = 0 for a one-dimensional state):
+/// the covered set's outline (grid bounds: outermost cells' edges), and boxes for the target
+/// (green), avoid (red) and safe (blue outline) sets of the configuration. Units: state units,
+/// in `frame_id`.
+visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config,
+                                                 const std::string& frame_id);
+
+}  // namespace amytiss_ros

@@ -1,0 +1,91 @@
+#include "plant_model.hpp"
+
+#include <cmath>
+
+#include "amytiss/errors.hpp"
+
+namespace amytiss_ros {
+
+PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
+    : config_(config), dynamics_(amytiss::make_dynamics(config)), random_(seed) {
+  state_dims_ = config.states.lb.size();
+  const std::size_t n = state_dims_;
+  noise_factor_.assign(n * n, 0.0);
+  const auto& noise = config.noise;
+  if (noise.distribution == amytiss::Distribution::Uniform) {
+    for (std::size_t i = 0; i < n; ++i) noise_factor_[i * n + i] = noise.half_width.at(i);
+    return;
+  }
+  if (noise.covariance.size() == n) {
+    for (std::size_t i = 0; i < n; ++i) noise_factor_[i * n + i] = std::sqrt(noise.covariance[i]);
+    return;
+  }
+  // Full covariance: Cholesky factor L (Sigma = L L^T), so L z with z ~ N(0, I) has covariance Sigma.
+  const auto& sigma = noise.covariance;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j <= i; ++j) {
+      double sum = sigma.at(i * n + j);
+      for (std::size_t k = 0; k < j; ++k) sum -= noise_factor_[i * n + k] * noise_factor_[j * n + k];
+      if (i == j) {
+        if (sum <= 0.0)
+          throw amytiss::ConfigError("noise.covariance", "is not positive definite (plant simulator)");
+        noise_factor_[i * n + i] = std::sqrt(sum);
+      } else {
+        noise_factor_[i * n + j] = sum / noise_factor_[j * n + j];
+      }
+    }
+  }
+}
+
+std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {
+  const std::size_t n = state_dims_;
+  std::vector<double> disturbance;
+  if (config_.disturbances) {
+    for (std::size_t i = 0; i < config_.disturbances->lb.size(); ++i)
+      disturbance.push_back(
+          std::uniform_real_distribution<double>(config_.disturbances->lb[i], config_.disturbances->ub[i])(random_));
+  }
+  std::vector<double> next(n);
+  dynamics_->evaluate(state.data(), input.empty() ? nullptr : input.data(),
+                      disturbance.empty() ? nullptr : disturbance.data(), next.data());
+  std::vector<double> standard(n);
+  const bool uniform = config_.noise.distribution == amytiss::Distribution::Uniform;
+  for (auto& z : standard)
+    z = uniform ? std::uniform_real_distribution<double>(-1.0, 1.0)(random_)
+                : std::normal_distribution<double>(0.0, 1.0)(random_);
+  for (std::size_t i = 0; i < n; ++i) {
+    double noise = 0.0;
+    for (std::size_t k = 0; k <= i; ++k) noise += noise_factor_[i * n + k] * standard[k];
+    if (config_.noise.type == amytiss::NoiseType::Multiplicative) noise *= std::abs(state[i]);
+    next[i] += noise;
+  }
+  return next;
+}
+
+StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state) {
+  if (state.size() != policy.states.dims()) return StateClass::OutsideGrid;
+  const auto cell = policy.states.cell_of(state.data());
+  if (!cell) return StateClass::OutsideGrid;
+  switch (policy.roles.at(*cell)) {
+    case amytiss::CellRole::FixedOne: return StateClass::Target;
+    case amytiss::CellRole::FixedZero: return StateClass::Unsafe;
+    default: return StateClass::Free;
+  }
+}
+
+EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step) {
+  const std::string at = " at step " + std::to_string(step);
+  const bool safety = spec == amytiss::SpecType::Safety;
+  switch (state_class) {
+    case StateClass::Target: return {true, "reached the target" + at};
+    case StateClass::Unsafe:
+      return {false, safety ? "left the safe set" + at : "entered the avoid set" + at};
+    case StateClass::OutsideGrid: return {false, "left the grid" + at};
+    case StateClass::Free:
+    default:
+      if (safety) return {true, "stayed safe for all " + std::to_string(step) + " steps (horizon over)"};
+      return {false, "horizon over after " + std::to_string(step) + " steps without reaching the target"};
+  }
+}
+
+}  // namespace amytiss_ros

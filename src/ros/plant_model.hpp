@@ -1,0 +1,49 @@
+#pragma once
+// A concrete stochastic plant for closed-loop simulation: x+ = f(x, u, w) + noise (additive) or
+// f(x, u, w) + noise * |x| (multiplicative, per component), with its own seeded random numbers.
+// The disturbance w, when the configuration has one, is drawn uniformly from its box each step
+// (the synthesis assumed the worst case, so a random one can only do better).
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "amytiss/config.hpp"
+#include "amytiss/model.hpp"
+#include "amytiss/policy.hpp"
+
+namespace amytiss_ros {
+
+class PlantModel {
+ public:
+  /// Throws ConfigError (from make_dynamics, or for a covariance that has no Cholesky factor).
+  PlantModel(const amytiss::Config& config, std::uint64_t seed);
+
+  std::size_t state_dims() const { return state_dims_; }
+  /// One step from `state` under `input` (input dims of the configuration, empty if none).
+  std::vector<double> step(const std::vector<double>& state, const std::vector<double>& input);
+
+ private:
+  amytiss::Config config_;
+  std::unique_ptr<amytiss::Dynamics> dynamics_;
+  std::size_t state_dims_ = 0;
+  std::vector<double> noise_factor_;  // lower-triangular n*n (normal: Cholesky factor of the covariance)
+  std::mt19937_64 random_;
+};
+
+/// Where a concrete state stands with respect to the specification, by its cell's role.
+enum class StateClass { Free, Target, Unsafe, OutsideGrid };
+/// Target: role FixedOne (target G); Unsafe: role FixedZero (avoid set A, or outside the safe set).
+StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state);
+
+/// The outcome of one episode.
+struct EpisodeOutcome {
+  bool success = false;
+  std::string description;  ///< "reached the target at step 12", "entered the avoid set at step 3", ...
+};
+/// Outcome of an episode that ended at `step` in a state of class `state_class` (for Free: the
+/// horizon is over). Reach specs succeed on Target; safety succeeds when the horizon is over.
+EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step);
+
+}  // namespace amytiss_ros

@@ -1,0 +1,237 @@
+#include "plant_simulator.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <amytiss/StateStamped.h>
+
+#include "amytiss/policy_file.hpp"
+#include "config_from_params.hpp"
+#include "plant_model.hpp"
+#include "synthesizer.hpp"
+
+namespace amytiss_ros {
+
+PlantSimulatorNode::PlantSimulatorNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle)
+    : public_handle_(public_handle), private_handle_(private_handle) {
+  state_publisher_ = public_handle_.advertise<amytiss::StateStamped>("state", 10);
+  summary_publisher_ = public_handle_.advertise<amytiss::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
+  status_subscriber_ = public_handle_.subscribe("status", 10, &PlantSimulatorNode::on_status, this);
+  command_subscriber_ = public_handle_.subscribe("command", 10, &PlantSimulatorNode::on_command, this,
+                                                 ros::TransportHints().tcpNoDelay());
+}
+
+void PlantSimulatorNode::on_status(const amytiss::PolicyStatus::ConstPtr& status) {
+  if (!status->ready) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  ready_status_ = status;
+  changed_.notify_all();
+}
+
+void PlantSimulatorNode::on_command(const amytiss::InputCommand::ConstPtr& command) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  last_command_ = command;
+  changed_.notify_all();
+}
+
+namespace {
+
+std::string join(const std::vector<double>& values) {
+  std::ostringstream text;
+  text.precision(6);
+  for (std::size_t i = 0; i < values.size(); ++i) text << (i ? ", " : "") << values[i];
+  return text.str();
+}
+
+/// One CSV row without the success column; an empty input (the final state) leaves u and
+/// probability empty.
+std::string csv_row(int episode, unsigned step, const std::vector<double>& state, const std::vector<double>& input,
+                    std::size_t input_dims, double probability) {
+  std::ostringstream row;
+  row.precision(10);
+  row << episode << "," << step;
+  for (double x : state) row << "," << x;
+  for (std::size_t i = 0; i < input_dims; ++i) {
+    row << ",";
+    if (i < input.size()) row << input[i];
+  }
+  row << ",";
+  if (!std::isnan(probability)) row << probability;
+  return row.str();
+}
+
+}  // namespace
+
+int PlantSimulatorNode::run() {
+  std::vector<double> initial_state;
+  int episodes = 20, seed = 1;
+  double command_timeout_s = 5.0, policy_timeout_s = 600.0;
+  std::string output_dir, plot_script, python;
+  bool exit_when_done = true;
+  private_handle_.getParam("initial_state", initial_state);
+  private_handle_.param("episodes", episodes, 20);
+  private_handle_.param("seed", seed, 1);
+  private_handle_.param("command_timeout_s", command_timeout_s, 5.0);
+  private_handle_.param("policy_timeout_s", policy_timeout_s, 600.0);
+  private_handle_.param<std::string>("output_dir", output_dir, "");
+  private_handle_.param<std::string>("plot_script", plot_script, "");
+  private_handle_.param<std::string>("python", python, "/usr/bin/python3");
+  private_handle_.param("exit_when_done", exit_when_done, true);
+  if (output_dir.empty())
+    output_dir = std::filesystem::path(default_policy_path("x")).parent_path().string() + "/episodes";
+
+  ROS_INFO("plant simulator: waiting for a policy on %s", status_subscriber_.getTopic().c_str());
+  amytiss::PolicyStatus::ConstPtr status;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait_for(lock, std::chrono::duration<double>(policy_timeout_s),
+                      [&] { return ready_status_ != nullptr || !ros::ok(); });
+    status = ready_status_;
+  }
+  if (!status) {
+    ROS_ERROR("plant simulator: no policy became ready within %.0f s", policy_timeout_s);
+    return 1;
+  }
+  amytiss::LoadedPolicy loaded;
+  amytiss::Config config;
+  try {
+    loaded = amytiss::read_policy_file(status->policy_file);
+    config = config_from_yaml_text(loaded.config_yaml);
+  } catch (const std::exception& error) {
+    ROS_ERROR("plant simulator: cannot read the policy %s: %s", status->policy_file.c_str(), error.what());
+    return 1;
+  }
+  const amytiss::Policy& policy = loaded.policy;
+  if (initial_state.size() != policy.states.dims()) {
+    ROS_ERROR("plant simulator: ~initial_state has %zu values, expected %zu (x0..x%zu)", initial_state.size(),
+              policy.states.dims(), policy.states.dims() - 1);
+    return 1;
+  }
+  PlantModel plant(config, static_cast<std::uint64_t>(seed));
+  std::vector<double> predicted_input(policy.inputs.dims());
+  double predicted = 0.0;
+  if (policy.lookup(initial_state.data(), initial_state.size(), 0, predicted_input.data(), &predicted) !=
+      amytiss::LookupStatus::Ok)
+    predicted = 0.0;
+  ROS_INFO("plant simulator: '%s', %d episodes from [%s], seed %d; predicted V_0 = %.4f", config.name.c_str(),
+           episodes, join(initial_state).c_str(), seed, predicted);
+
+  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(command_timeout_s * 4);
+  while (ros::ok() && (state_publisher_.getNumSubscribers() == 0 || command_subscriber_.getNumPublishers() == 0)) {
+    if (ros::WallTime::now() > connect_deadline) {
+      ROS_ERROR("plant simulator: the policy server is not connected to %s / %s",
+                state_publisher_.getTopic().c_str(), command_subscriber_.getTopic().c_str());
+      return 1;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+
+  std::filesystem::create_directories(output_dir);
+  const std::string base = output_dir + "/" + config.name;
+  const std::string csv_path = base + "_episodes.csv";
+  std::ofstream csv(csv_path);
+  csv << "episode,step";
+  for (std::size_t i = 0; i < policy.states.dims(); ++i) csv << ",x" << i;
+  for (std::size_t i = 0; i < policy.inputs.dims(); ++i) csv << ",u" << i;
+  csv << ",probability,success\n";
+  csv.precision(10);
+
+  amytiss::EpisodeSummary summary;
+  summary.initial_state = initial_state;
+  summary.predicted_probability = predicted;
+  ros::Time last_stamp;
+  for (int episode = 1; episode <= episodes && ros::ok(); ++episode) {
+    std::vector<double> state = initial_state;
+    std::vector<std::string> rows;  // "episode,step,x..,u..,probability"; success appended at the end
+    EpisodeOutcome outcome;
+    unsigned step = 0;
+    for (;; ++step) {
+      const StateClass state_class = classify_state(policy, state);
+      if (state_class != StateClass::Free || step >= policy.horizon) {
+        outcome = episode_outcome(config.spec.type, state_class, step);
+        rows.push_back(csv_row(episode, step, state, {}, policy.inputs.dims(), std::nan("")));
+        break;
+      }
+      amytiss::InputCommand::ConstPtr command;
+      // The server loads the policy after the status says ready: until then it answers "no policy
+      // yet", and the state is sent again (bounded by policy_timeout_s).
+      const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(policy_timeout_s);
+      for (;;) {
+        amytiss::StateStamped message;
+        message.header.stamp = ros::Time::now();
+        if (message.header.stamp <= last_stamp) message.header.stamp = last_stamp + ros::Duration(0, 1);
+        last_stamp = message.header.stamp;
+        message.header.frame_id = "map";
+        message.state = state;
+        message.time_step = step;
+        command.reset();
+        {
+          std::unique_lock<std::mutex> lock(mutex_);
+          state_publisher_.publish(message);
+          const bool answered = changed_.wait_for(lock, std::chrono::duration<double>(command_timeout_s), [&] {
+            return !ros::ok() || (last_command_ && last_command_->header.stamp == message.header.stamp &&
+                                  last_command_->time_step == step);
+          });
+          if (answered) command = last_command_;
+        }
+        const bool not_loaded_yet = command && !command->valid && command->message.rfind("no policy yet", 0) == 0;
+        if (!not_loaded_yet || ros::WallTime::now() > give_up || !ros::ok()) break;
+        ros::WallDuration(0.05).sleep();
+      }
+      if (!command) {
+        outcome = {false, "no command from the policy server within " + std::to_string(command_timeout_s) +
+                              " s at step " + std::to_string(step)};
+        break;
+      }
+      if (!command->valid) {
+        outcome = {false, "unsafe: the server gave no input at step " + std::to_string(step) + " (" +
+                              command->message + ")"};
+        break;
+      }
+      rows.push_back(csv_row(episode, step, state, command->input, policy.inputs.dims(), command->probability));
+      state = plant.step(state, command->input);
+    }
+    summary.episodes += 1;
+    if (outcome.success) summary.successes += 1;
+    const std::string line = "episode " + std::to_string(episode) + ": " + outcome.description;
+    summary.outcomes.push_back(line);
+    ROS_INFO("%s", line.c_str());
+    // The success flag goes on every row of the episode, so the plot can colour whole trajectories.
+    for (const auto& row : rows) csv << row << "," << (outcome.success ? 1 : 0) << "\n";
+  }
+  csv.close();
+  summary.csv_file = csv_path;
+  summary.success_rate = summary.episodes ? double(summary.successes) / summary.episodes : 0.0;
+  const double standard_error =
+      summary.episodes ? std::sqrt(summary.success_rate * (1 - summary.success_rate) / summary.episodes) : 0.0;
+  ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); predicted V_0 at the "
+           "start state = %.4f",
+           summary.successes, summary.episodes, summary.success_rate, standard_error, predicted);
+
+  if (!plot_script.empty()) {
+    summary.trajectories_png = base + "_trajectories.png";
+    summary.values_png = base + "_values.png";
+    const std::string command = python + " '" + plot_script + "' --csv '" + csv_path + "' --policy '" +
+                                status->policy_file + "' --initial-state '" + join(initial_state) +
+                                "' --trajectories '" + summary.trajectories_png + "' --values '" +
+                                summary.values_png + "'";
+    if (std::system(command.c_str()) == 0) {
+      ROS_INFO("pictures: %s and %s", summary.trajectories_png.c_str(), summary.values_png.c_str());
+    } else {
+      ROS_WARN("the plot script failed (%s); trajectories are in %s", command.c_str(), csv_path.c_str());
+      summary.trajectories_png.clear();
+      summary.values_png.clear();
+    }
+  }
+  ROS_INFO("trajectories: %s", csv_path.c_str());
+  summary.header.stamp = ros::Time::now();
+  summary_publisher_.publish(summary);
+  if (!exit_when_done) ros::waitForShutdown();
+  return 0;
+}
+
+}  // namespace amytiss_ros

@@ -1,0 +1,48 @@
+#pragma once
+// The plant simulator node's logic: closes the loop through the policy server's topics.
+//
+// Waits for a ready policy on /amytiss/status, reads its file (configuration and V_0 inside),
+// then runs ~episodes episodes from ~initial_state: publish amytiss/StateStamped on state, wait
+// for the matching amytiss/InputCommand on command, step the plant (PlantModel), until the
+// target, the avoid set / outside the safe set, leaving the grid, or the horizon. Logs each
+// outcome and, at the end, the empirical success rate next to V_0 of the start state; writes a
+// CSV of the trajectories and pictures (scripts/plot_episodes.py) into ~output_dir; publishes a
+// latched amytiss/EpisodeSummary on episode_summary.
+// Private parameters: initial_state (list, state units, required), episodes (int, 20), seed
+// (int, 1), output_dir (string, default $ROS_HOME/amytiss/episodes), plot_script (string, empty:
+// no pictures), python (string, /usr/bin/python3), command_timeout_s (5), policy_timeout_s
+// (600), exit_when_done (bool, true).
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <amytiss/EpisodeSummary.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/PolicyStatus.h>
+#include <ros/ros.h>
+
+namespace amytiss_ros {
+
+class PlantSimulatorNode {
+ public:
+  PlantSimulatorNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle);
+  /// Runs all episodes (needs a spinner running in other threads). Returns the process exit code:
+  /// 0 when all episodes ran, 1 when the policy or the server never came.
+  int run();
+
+ private:
+  void on_status(const amytiss::PolicyStatus::ConstPtr& status);
+  void on_command(const amytiss::InputCommand::ConstPtr& command);
+
+  ros::NodeHandle public_handle_, private_handle_;
+  ros::Publisher state_publisher_, summary_publisher_;
+  ros::Subscriber status_subscriber_, command_subscriber_;
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  amytiss::PolicyStatus::ConstPtr ready_status_;
+  amytiss::InputCommand::ConstPtr last_command_;
+};
+
+}  // namespace amytiss_ros

@@ -1,0 +1,256 @@
+#include "synthesizer.hpp"
+
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/errors.hpp"
+#include "amytiss/policy_file.hpp"
+#include "config_from_params.hpp"
+#include "conversions.hpp"
+
+namespace amytiss_ros {
+
+std::string default_policy_path(const std::string& config_name) {
+  std::string home;
+  if (const char* ros_home = std::getenv("ROS_HOME"); ros_home && *ros_home) {
+    home = ros_home;
+  } else {
+    const char* user_home = std::getenv("HOME");
+    home = std::string(user_home ? user_home : "/tmp") + "/.ros";
+  }
+  std::string safe_name;
+  for (char c : config_name)
+    safe_name += (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-') ? c : '_';
+  if (safe_name.empty()) safe_name = "policy";
+  return home + "/amytiss/" + safe_name + ".h5";
+}
+
+SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle)
+    : public_handle_(public_handle),
+      private_handle_(private_handle),
+      action_server_(public_handle, "synthesize",
+                     [this](const amytiss::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
+  status_publisher_ = public_handle_.advertise<amytiss::PolicyStatus>("status", 1, /*latch=*/true);
+  update_status([](amytiss::PolicyStatus& status) {
+    status.phase = "idle";
+    status.remaining_s = -1;
+    status.message = "synthesizer started";
+  });
+}
+
+SynthesizerNode::~SynthesizerNode() {
+  cancel_startup_job_ = true;
+  if (startup_thread_.joinable()) startup_thread_.join();
+}
+
+void SynthesizerNode::start() {
+  action_server_.start();
+  bool synthesize_on_start = true;
+  private_handle_.param("synthesize_on_start", synthesize_on_start, true);
+  if (!synthesize_on_start) return;
+  startup_thread_ = std::thread([this] {
+    std::lock_guard<std::mutex> job_lock(job_mutex_);
+    run_from_source([this] { return read_parameters(); }, /*force=*/false,
+                    [this] { return cancel_startup_job_.load() || !ros::ok(); },
+                    [](const amytiss::Progress&) {});
+  });
+}
+
+amytiss::Config SynthesizerNode::read_parameters() const {
+  XmlRpc::XmlRpcValue tree;
+  // Uncached on purpose: a new goal must see parameters set since the last one.
+  if (!ros::param::get(private_handle_.getNamespace(), tree)) tree = XmlRpc::XmlRpcValue();
+  std::string device;
+  private_handle_.param<std::string>("device", device, "");
+  return config_from_params(tree, device);
+}
+
+std::string SynthesizerNode::policy_path_for(const amytiss::Config& config) const {
+  std::string path;
+  private_handle_.param<std::string>("policy_file", path, "");
+  if (path.empty()) path = default_policy_path(config.name);
+  return std::filesystem::absolute(path).lexically_normal().string();
+}
+
+void SynthesizerNode::update_status(const std::function<void(amytiss::PolicyStatus&)>& edit) {
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  edit(status_);
+  status_.header.stamp = ros::Time::now();
+  status_publisher_.publish(status_);
+}
+
+SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<amytiss::Config()>& read_config,
+                                                          bool force, const CancelCheck& cancelled,
+                                                          const ProgressSink& on_progress) {
+  amytiss::Config config;
+  try {
+    config = read_config();
+  } catch (const std::exception& error) {
+    Outcome outcome;
+    outcome.message = std::string("invalid configuration: ") + error.what();
+    ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.synthesizing = false;
+      status.phase = "error";
+      status.message = outcome.message;
+    });
+    return outcome;
+  }
+  return run(config, force, cancelled, on_progress);
+}
+
+SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, bool force,
+                                              const CancelCheck& cancelled, const ProgressSink& on_progress) {
+  Outcome outcome;
+  const std::string hash = amytiss::config_hash(config);
+  const std::string device = amytiss::to_string(config.compute.device);
+  try {
+    outcome.policy_file = policy_path_for(config);
+  } catch (const std::exception& error) {
+    outcome.message = std::string("bad policy_file parameter: ") + error.what();
+    ROS_ERROR("%s", outcome.message.c_str());
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.phase = "error";
+      status.message = outcome.message;
+    });
+    return outcome;
+  }
+  const auto announce = [&](unsigned horizon, const std::string& phase, const std::string& computed_by) {
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.ready = true;
+      status.synthesizing = false;
+      status.percent = 100.0;
+      status.phase = phase;
+      status.device = computed_by;
+      status.remaining_s = 0.0;
+      status.message = outcome.message;
+      status.config_name = config.name;
+      status.config_hash = hash;
+      status.policy_file = outcome.policy_file;
+      status.horizon = horizon;
+      status.generation += 1;
+      if (phase == "done") status.syntheses_run += 1;
+    });
+  };
+
+  if (!force && std::filesystem::exists(outcome.policy_file)) {
+    try {
+      const amytiss::LoadedPolicy loaded = amytiss::read_policy_file_for(outcome.policy_file, config);
+      outcome.success = true;
+      outcome.reused = true;
+      outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name +
+                        "' unchanged, hash " + hash + "); nothing to synthesize";
+      ROS_INFO("%s", outcome.message.c_str());
+      announce(loaded.policy.horizon, "reused", loaded.policy.computed_by);
+      return outcome;
+    } catch (const amytiss::PolicyFileError& error) {
+      ROS_INFO("not reusing %s: %s", outcome.policy_file.c_str(), error.what());
+    }
+  }
+
+  ROS_INFO("synthesizing '%s' (hash %s, horizon %u) on device %s -> %s", config.name.c_str(), hash.c_str(),
+           config.spec.horizon, device.c_str(), outcome.policy_file.c_str());
+  update_status([&](amytiss::PolicyStatus& status) {
+    status.synthesizing = true;
+    status.percent = 0.0;
+    status.phase = "setup";
+    status.device = device;
+    status.remaining_s = -1;
+    status.message = "synthesizing '" + config.name + "' on " + device;
+  });
+  const auto started = std::chrono::steady_clock::now();
+  try {
+    const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config);
+    amytiss::SynthesisOptions options;
+    options.compute = config.compute;
+    options.progress = [&](const amytiss::Progress& progress) {
+      const std::string text = describe_progress(progress);
+      ROS_INFO("%s", text.c_str());
+      update_status([&](amytiss::PolicyStatus& status) {
+        status.synthesizing = true;
+        status.percent = progress.percent();
+        status.phase = progress.phase;
+        status.device = progress.device;
+        status.remaining_s = progress.remaining_s;
+        status.message = text;
+      });
+      on_progress(progress);
+      return !cancelled();
+    };
+    amytiss::SynthesisReport report;
+    const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
+    for (const auto& note : report.log) {
+      // Device fallbacks are warnings (SPEC section 7); the other notes (storage, memory) are facts.
+      if (note.find("fall") != std::string::npos || note.find("no OpenCL") != std::string::npos)
+        ROS_WARN("%s", note.c_str());
+      else
+        ROS_INFO("%s", note.c_str());
+    }
+    if (cancelled()) throw amytiss::Cancelled();
+    std::filesystem::create_directories(std::filesystem::path(outcome.policy_file).parent_path());
+    amytiss::write_policy_file(outcome.policy_file, policy, config);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const amytiss::ValueSummary summary = amytiss::summarize_initial_values(policy);
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "new policy '%s' synthesized in %.2f s on %s: V_0 over free cells min %.4f mean %.4f "
+                  "max %.4f; written to %s",
+                  config.name.c_str(), seconds, policy.computed_by.c_str(), summary.min, summary.mean,
+                  summary.max, outcome.policy_file.c_str());
+    outcome.success = true;
+    outcome.message = text;
+    ROS_INFO("%s", text);
+    announce(policy.horizon, "done", policy.computed_by);
+  } catch (const amytiss::Cancelled&) {
+    outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
+    ROS_WARN("%s", outcome.message.c_str());
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.synthesizing = false;
+      status.phase = "cancelled";
+      status.remaining_s = -1;
+      status.message = outcome.message;
+    });
+  } catch (const std::exception& error) {
+    outcome.message = "synthesis of '" + config.name + "' failed: " + error.what();
+    ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.synthesizing = false;
+      status.phase = "error";
+      status.remaining_s = -1;
+      status.message = outcome.message;
+    });
+  }
+  return outcome;
+}
+
+void SynthesizerNode::execute_goal(const amytiss::SynthesizeGoalConstPtr& goal) {
+  cancel_startup_job_ = true;
+  std::lock_guard<std::mutex> job_lock(job_mutex_);
+  const auto read_config = [&]() {
+    if (goal->config_yaml.empty()) return read_parameters();
+    std::string device;
+    private_handle_.param<std::string>("device", device, "");
+    return config_from_yaml_text(goal->config_yaml, device);
+  };
+  const Outcome outcome = run_from_source(
+      read_config, goal->force,
+      [this] { return action_server_.isPreemptRequested() || !ros::ok(); },
+      [this](const amytiss::Progress& progress) { action_server_.publishFeedback(feedback_from_progress(progress)); });
+  amytiss::SynthesizeResult result;
+  result.success = outcome.success;
+  result.message = outcome.message;
+  result.policy_file = outcome.success ? outcome.policy_file : "";
+  result.reused = outcome.reused;
+  if (outcome.success)
+    action_server_.setSucceeded(result, outcome.message);
+  else if (action_server_.isPreemptRequested())
+    action_server_.setPreempted(result, outcome.message);
+  else
+    action_server_.setAborted(result, outcome.message);
+}
+
+}  // namespace amytiss_ros

@@ -1,0 +1,176 @@
+// rostest: re-synthesis through the action with new parameters, hot swap, reuse, cancel, errors.
+#include <atomic>
+#include <thread>
+
+#include <actionlib/client/simple_action_client.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/SynthesizeAction.h>
+
+#include "amytiss/policy_file.hpp"
+#include "rostest_support.hpp"
+
+namespace {
+
+constexpr double kActionWaitSeconds = 60.0;
+const std::string kSynthesizer = "/amytiss/synthesizer";
+// A configuration big enough (about 0.1 s per step on the reference engine, 40 steps) to be
+// cancelled while it runs.
+const char* kSlowConfig = R"YAML(
+name: slow_for_cancel
+states:  {lb: [-5, -5], ub: [5, 5], eta: [0.125, 0.125]}
+inputs:  {lb: [0, -3.2], ub: [1, 3.2], eta: [0.5, 0.4]}
+dynamics: ["x0 + u0*cos(u1)", "x1 + u0*sin(u1)"]
+noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncation: cutting_probability, cutting_probability: 1.0e-4}
+spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
+)YAML";
+
+using Client = actionlib::SimpleActionClient<amytiss::SynthesizeAction>;
+
+class ResynthesisTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
+    client_ = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/false);
+    ASSERT_TRUE(action_.waitForServer(ros::Duration(amytiss_test::kServiceWaitSeconds)));
+    ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready && !s.synthesizing; },
+                                 amytiss_test::kPolicyWaitSeconds))
+        << status_.latest().message;
+    ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
+  }
+  amytiss::GetInput::Response call(const std::vector<double>& state, unsigned step) {
+    amytiss::GetInput service;
+    service.request.state = state;
+    service.request.time_step = step;
+    EXPECT_TRUE(client_.call(service));
+    return service.response;
+  }
+  amytiss::SynthesizeResult run_goal(const amytiss::SynthesizeGoal& goal) {
+    action_.sendGoal(goal);
+    EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
+    return *action_.getResult();
+  }
+
+  ros::NodeHandle handle_;
+  amytiss_test::StatusWatcher status_{handle_};
+  ros::ServiceClient client_;
+  Client action_{"/amytiss/synthesize", true};
+};
+
+TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
+  const amytiss::PolicyStatus before = status_.latest();
+
+  // Requests keep being answered, successfully, during the whole re-synthesis and swap.
+  std::atomic<bool> stop{false};
+  std::atomic<int> answered{0}, failed{0};
+  std::thread caller([&] {
+    ros::ServiceClient client = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input");
+    while (!stop) {
+      amytiss::GetInput service;
+      service.request.state = {-4.0, -4.0};
+      service.request.time_step = 0;
+      if (client.call(service) && service.response.success) ++answered; else ++failed;
+    }
+  });
+
+  ros::param::set(kSynthesizer + "/spec/horizon", 9);
+  XmlRpc::XmlRpcValue target_lb;
+  target_lb.setSize(2);
+  target_lb[0] = 2.0;
+  target_lb[1] = 2.0;
+  ros::param::set(kSynthesizer + "/spec/target/lb", target_lb);
+  const amytiss::SynthesizeResult changed = run_goal(amytiss::SynthesizeGoal());
+  EXPECT_TRUE(changed.success) << changed.message;
+  EXPECT_FALSE(changed.reused);
+  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > before.generation; },
+                               amytiss_test::kPolicyWaitSeconds));
+  const amytiss::PolicyStatus after = status_.latest();
+  EXPECT_EQ(after.syntheses_run, before.syntheses_run + 1);
+  EXPECT_NE(after.config_hash, before.config_hash);
+  EXPECT_EQ(after.horizon, 9u);
+
+  // The server swaps to the new policy: step 9 becomes beyond the horizon, and answers equal the
+  // new file's.
+  ASSERT_TRUE(amytiss_test::poll_until([&] { return !call({-4.0, -4.0}, 9).success; }, amytiss_test::kPolicyWaitSeconds));
+  const amytiss::LoadedPolicy fresh = amytiss::read_policy_file(after.policy_file);
+  EXPECT_EQ(fresh.config_hash, after.config_hash);
+  std::vector<double> expected(fresh.policy.inputs.dims());
+  double probability = -1;
+  const std::vector<double> state = {-3.0, -4.0};
+  ASSERT_EQ(fresh.policy.lookup(state.data(), 2, 1, expected.data(), &probability), amytiss::LookupStatus::Ok);
+  const amytiss::GetInput::Response response = call(state, 1);
+  EXPECT_TRUE(response.success);
+  EXPECT_EQ(response.input, expected);
+  EXPECT_EQ(response.probability, probability);
+
+  stop = true;
+  caller.join();
+  EXPECT_EQ(failed.load(), 0);
+  EXPECT_GT(answered.load(), 0);
+
+  // Unchanged parameters: the file is reused, nothing is computed.
+  const amytiss::SynthesizeResult unchanged = run_goal(amytiss::SynthesizeGoal());
+  EXPECT_TRUE(unchanged.success) << unchanged.message;
+  EXPECT_TRUE(unchanged.reused);
+  EXPECT_NE(unchanged.message.find("reusing"), std::string::npos) << unchanged.message;
+  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > after.generation; },
+                               amytiss_test::kPolicyWaitSeconds));
+  EXPECT_EQ(status_.latest().syntheses_run, after.syntheses_run);
+  EXPECT_EQ(status_.latest().phase, "reused");
+
+  // force: computed again although the file is valid.
+  amytiss::SynthesizeGoal forced;
+  forced.force = true;
+  const amytiss::SynthesizeResult recomputed = run_goal(forced);
+  EXPECT_TRUE(recomputed.success);
+  EXPECT_FALSE(recomputed.reused);
+}
+
+TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
+  const amytiss::PolicyStatus before = status_.latest();
+  std::atomic<int> feedbacks{0};
+  amytiss::SynthesizeGoal goal;
+  goal.config_yaml = kSlowConfig;
+  goal.force = true;
+  action_.sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                   [&](const amytiss::SynthesizeFeedbackConstPtr& feedback) {
+                     if (feedback->phase == "synthesis") ++feedbacks;
+                   });
+  ASSERT_TRUE(amytiss_test::poll_until([&] { return feedbacks > 0; }, kActionWaitSeconds));
+  action_.cancelGoal();
+  ASSERT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
+  EXPECT_EQ(action_.getState(), actionlib::SimpleClientGoalState::PREEMPTED);
+  EXPECT_FALSE(action_.getResult()->success);
+  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
+  const amytiss::PolicyStatus after = status_.latest();
+  EXPECT_TRUE(after.ready);
+  EXPECT_EQ(after.generation, before.generation);
+  EXPECT_EQ(after.config_hash, before.config_hash);
+  EXPECT_TRUE(call({-4.0, -4.0}, 0).success);
+}
+
+TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
+  const amytiss::PolicyStatus before = status_.latest();
+  amytiss::SynthesizeGoal goal;
+  goal.config_yaml = std::string(kSlowConfig) + "\n";
+  goal.config_yaml.replace(goal.config_yaml.find("horizon: 40"), 11, "horizon: 0");
+  const amytiss::SynthesizeResult result = run_goal(goal);
+  EXPECT_FALSE(result.success);
+  EXPECT_NE(result.message.find("horizon"), std::string::npos) << result.message;
+  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
+  EXPECT_NE(status_.latest().message.find("horizon"), std::string::npos);
+  EXPECT_TRUE(status_.latest().ready);
+  EXPECT_EQ(status_.latest().generation, before.generation);
+  EXPECT_TRUE(call({-4.0, -4.0}, 0).success);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "amytiss_resynthesis_test");
+  ros::AsyncSpinner spinner(3);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  ros::shutdown();
+  return result;
+}

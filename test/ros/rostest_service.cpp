@@ -1,0 +1,138 @@
+// rostest: the policy server's service and closed-loop topics against the core policy.
+#include <cmath>
+#include <condition_variable>
+#include <limits>
+#include <random>
+
+#include <amytiss/GetInput.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/StateStamped.h>
+
+#include "amytiss/policy_file.hpp"
+#include "rostest_support.hpp"
+
+namespace {
+
+constexpr int kSampledStates = 300;
+constexpr unsigned kRandomSeed = 20240601;
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
+    client_ = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input");
+    ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready; },
+                                 amytiss_test::kPolicyWaitSeconds))
+        << "no ready policy; last status: " << status_.latest().message;
+    loaded_ = amytiss::read_policy_file(status_.latest().policy_file);
+    // The server loads the file after the status arrives: wait until it answers.
+    ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
+  }
+  amytiss::GetInput::Response call(const std::vector<double>& state, unsigned step) {
+    amytiss::GetInput service;
+    service.request.state = state;
+    service.request.time_step = step;
+    EXPECT_TRUE(client_.call(service)) << "the service call itself failed";
+    return service.response;
+  }
+
+  ros::NodeHandle handle_;
+  amytiss_test::StatusWatcher status_{handle_};
+  ros::ServiceClient client_;
+  amytiss::LoadedPolicy loaded_;
+};
+
+TEST_F(ServiceTest, AnswersEqualTheCorePolicyForSampledStates) {
+  const amytiss::Policy& policy = loaded_.policy;
+  std::mt19937 random(kRandomSeed);
+  std::vector<double> expected_input(policy.inputs.dims());
+  for (int sample = 0; sample < kSampledStates; ++sample) {
+    std::vector<double> state(policy.states.dims());
+    for (std::size_t d = 0; d < state.size(); ++d) {
+      const double low = policy.states.lb()[d] - 0.49 * policy.states.eta()[d];
+      const double high = policy.states.last_point()[d] + 0.49 * policy.states.eta()[d];
+      state[d] = std::uniform_real_distribution<double>(low, high)(random);
+    }
+    const unsigned step = std::uniform_int_distribution<unsigned>(0, policy.horizon - 1)(random);
+    double expected_probability = -1;
+    ASSERT_EQ(policy.lookup(state.data(), state.size(), step, expected_input.data(), &expected_probability),
+              amytiss::LookupStatus::Ok);
+    const amytiss::GetInput::Response response = call(state, step);
+    ASSERT_TRUE(response.success) << response.message;
+    EXPECT_EQ(response.input, expected_input);
+    EXPECT_EQ(response.probability, expected_probability);
+  }
+}
+
+TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStaysUp) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const unsigned horizon = loaded_.policy.horizon;
+  const struct {
+    std::vector<double> state;
+    unsigned step;
+    const char* expected_word;
+  } cases[] = {{{}, 0, "expected 2"},          {{1.0}, 0, "expected 2"},      {{1.0, 2.0, 3.0}, 0, "expected 2"},
+               {{nan, 0.0}, 0, "finite"},      {{0.0, inf}, 0, "finite"},     {{-inf, 0.0}, 0, "finite"},
+               {{40.0, 0.0}, 0, "outside"},    {{0.0, -5.26}, 0, "outside"},  {{0.0, 0.0}, horizon, "horizon"},
+               {{0.0, 0.0}, 4000000000u, "horizon"}};
+  for (const auto& c : cases) {
+    const amytiss::GetInput::Response response = call(c.state, c.step);
+    EXPECT_FALSE(response.success);
+    EXPECT_TRUE(response.input.empty());
+    EXPECT_NE(response.message.find(c.expected_word), std::string::npos) << response.message;
+  }
+  EXPECT_TRUE(client_.exists());
+  EXPECT_TRUE(call({-4.0, -4.0}, 0).success);
+}
+
+TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {
+  std::mutex mutex;
+  std::condition_variable arrived;
+  std::vector<amytiss::InputCommand> commands;
+  ros::Subscriber subscriber = handle_.subscribe<amytiss::InputCommand>(
+      "/amytiss/command", 10, [&](const amytiss::InputCommand::ConstPtr& command) {
+        std::lock_guard<std::mutex> lock(mutex);
+        commands.push_back(*command);
+        arrived.notify_all();
+      });
+  ros::Publisher publisher = handle_.advertise<amytiss::StateStamped>("/amytiss/state", 10);
+  ASSERT_TRUE(amytiss_test::poll_until(
+      [&] { return publisher.getNumSubscribers() > 0 && subscriber.getNumPublishers() > 0; },
+      amytiss_test::kServiceWaitSeconds));
+  amytiss::StateStamped good, bad;
+  good.header.stamp = ros::Time(100, 1);
+  good.state = {-4.0, -4.0};
+  good.time_step = 2;
+  bad.header.stamp = ros::Time(100, 2);
+  bad.state = {-4.0, std::numeric_limits<double>::quiet_NaN()};
+  bad.time_step = 2;
+  publisher.publish(good);
+  publisher.publish(bad);
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(arrived.wait_for(lock, std::chrono::seconds(10), [&] { return commands.size() >= 2; }));
+  std::vector<double> expected(loaded_.policy.inputs.dims());
+  double probability = -1;
+  ASSERT_EQ(loaded_.policy.lookup(good.state.data(), 2, 2, expected.data(), &probability), amytiss::LookupStatus::Ok);
+  EXPECT_EQ(commands[0].header.stamp, good.header.stamp);
+  EXPECT_TRUE(commands[0].valid);
+  EXPECT_EQ(commands[0].time_step, 2u);
+  EXPECT_EQ(commands[0].input, expected);
+  EXPECT_EQ(commands[0].probability, probability);
+  EXPECT_EQ(commands[1].header.stamp, bad.header.stamp);
+  EXPECT_FALSE(commands[1].valid);
+  EXPECT_TRUE(commands[1].input.empty());
+  EXPECT_NE(commands[1].message.find("finite"), std::string::npos) << commands[1].message;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "amytiss_service_test");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  ros::shutdown();
+  return result;
+}

@@ -1,0 +1,305 @@
+// ROS-layer conversions without a master: parameters -> Config, lookups -> messages, progress ->
+// feedback, markers, the plant model and outcome texts.
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <ros/serialization.h>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
+#include "config_from_params.hpp"
+#include "conversions.hpp"
+#include "plant_model.hpp"
+
+namespace {
+
+const std::string kTinyConfig = std::string(AMYTISS_SOURCE_DIR) + "/test/ros/tiny_reach_avoid.yaml";
+constexpr double kStatisticsStandardErrors = 4.0;
+
+XmlRpc::XmlRpcValue list(std::initializer_list<double> values) {
+  XmlRpc::XmlRpcValue array;
+  array.setSize(static_cast<int>(values.size()));
+  int i = 0;
+  for (double v : values) array[i++] = v;
+  return array;
+}
+
+XmlRpc::XmlRpcValue int_list(std::initializer_list<int> values) {
+  XmlRpc::XmlRpcValue array;
+  array.setSize(static_cast<int>(values.size()));
+  int i = 0;
+  for (int v : values) array[i++] = v;
+  return array;
+}
+
+// The same tree `rosparam load test/ros/tiny_reach_avoid.yaml` puts in the private namespace
+// (integers stay integers), plus the node's own keys.
+XmlRpc::XmlRpcValue tiny_parameter_tree() {
+  XmlRpc::XmlRpcValue tree;
+  tree["name"] = std::string("tiny_reach_avoid");
+  tree["states"]["lb"] = int_list({-5, -5});
+  tree["states"]["ub"] = int_list({5, 5});
+  tree["states"]["eta"] = list({0.5, 0.5});
+  tree["inputs"]["lb"] = list({0, -3.2});
+  tree["inputs"]["ub"] = list({1, 3.2});
+  tree["inputs"]["eta"] = list({0.5, 0.4});
+  tree["constants"]["tau"] = 1.0;
+  XmlRpc::XmlRpcValue dynamics;
+  dynamics.setSize(2);
+  dynamics[0] = std::string("x0 + tau*u0*cos(u1)");
+  dynamics[1] = std::string("x1 + tau*u0*sin(u1)");
+  tree["dynamics"] = dynamics;
+  tree["noise"]["type"] = std::string("additive");
+  tree["noise"]["distribution"] = std::string("normal");
+  tree["noise"]["covariance"] = list({0.05, 0.05});
+  tree["noise"]["truncation"] = std::string("cutting_probability");
+  tree["noise"]["cutting_probability"] = 1.0e-4;
+  tree["spec"]["type"] = std::string("reach_avoid");
+  tree["spec"]["horizon"] = 14;
+  tree["spec"]["target"]["lb"] = int_list({3, 3});
+  tree["spec"]["target"]["ub"] = list({4.5, 4.5});
+  tree["spec"]["avoid"]["lb"] = int_list({-1, -1});
+  tree["spec"]["avoid"]["ub"] = int_list({1, 1});
+  tree["compute"]["device"] = std::string("reference");
+  tree["compute"]["transitions"] = std::string("auto");
+  tree["policy_file"] = std::string("/tmp/somewhere.h5");
+  tree["device"] = std::string("cpu");
+  tree["synthesize_on_start"] = true;
+  return tree;
+}
+
+TEST(ConfigFromParams, EqualsTheFileItWasLoadedFrom) {
+  XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
+  const amytiss::Config from_params = amytiss_ros::config_from_params(tree);
+  const amytiss::Config from_file = amytiss::load_config_file(kTinyConfig);
+  EXPECT_EQ(amytiss::to_yaml(from_params), amytiss::to_yaml(from_file));
+  EXPECT_EQ(amytiss::config_hash(from_params), amytiss::config_hash(from_file));
+}
+
+TEST(ConfigFromParams, DeviceOverrideReplacesComputeDeviceButNotTheHash) {
+  XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
+  const amytiss::Config plain = amytiss_ros::config_from_params(tree);
+  const amytiss::Config on_cpu = amytiss_ros::config_from_params(tree, "cpu");
+  EXPECT_EQ(plain.compute.device, amytiss::DeviceKind::Reference);
+  EXPECT_EQ(on_cpu.compute.device, amytiss::DeviceKind::Cpu);
+  EXPECT_EQ(amytiss::config_hash(plain), amytiss::config_hash(on_cpu));
+  EXPECT_THROW(amytiss_ros::config_from_params(tree, "quantum"), amytiss::ConfigError);
+}
+
+TEST(ConfigFromParams, DoublesKeepFullPrecision) {
+  XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
+  const double awkward = 0.1 + 0.2;  // 0.30000000000000004
+  tree["noise"]["covariance"] = list({awkward, 0.05});
+  const amytiss::Config config = amytiss_ros::config_from_params(tree);
+  EXPECT_EQ(config.noise.covariance[0], awkward);
+}
+
+TEST(ConfigFromParams, BadValuesNameTheKey) {
+  XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
+  tree["spec"]["horizon"] = 0;
+  try {
+    amytiss_ros::config_from_params(tree);
+    FAIL() << "horizon 0 accepted";
+  } catch (const amytiss::ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("horizon"), std::string::npos) << error.what();
+  }
+  XmlRpc::XmlRpcValue empty;
+  EXPECT_THROW(amytiss_ros::config_from_params(empty), amytiss::ConfigError);
+}
+
+TEST(ConfigFromYamlText, NotYamlIsAConfigErrorOnConfigYaml) {
+  try {
+    amytiss_ros::config_from_yaml_text("name: [unclosed");
+    FAIL() << "broken YAML accepted";
+  } catch (const amytiss::ConfigError& error) {
+    EXPECT_EQ(error.key(), "config_yaml");
+  }
+}
+
+class LookupConversions : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const amytiss::Abstraction abstraction =
+        amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
+    policy_ = new amytiss::Policy(amytiss::synthesize_reference(abstraction, {}));
+  }
+  static void TearDownTestSuite() { delete policy_; }
+  static amytiss::Policy* policy_;
+};
+amytiss::Policy* LookupConversions::policy_ = nullptr;
+
+TEST_F(LookupConversions, ResponseEqualsThePolicyForEveryCellAndStep) {
+  amytiss::GetInput::Response response;
+  std::vector<double> expected_input(policy_->inputs.dims());
+  for (unsigned step = 0; step < policy_->horizon; ++step) {
+    for (std::size_t cell = 0; cell < policy_->states.size(); ++cell) {
+      const std::vector<double> state = policy_->states.point(cell);
+      amytiss_ros::fill_get_input_response(policy_, state, step, "", response);
+      ASSERT_TRUE(response.success) << response.message;
+      EXPECT_TRUE(response.message.empty());
+      const std::uint32_t index = policy_->input(step, cell);
+      policy_->inputs.point(index, expected_input.data());
+      ASSERT_EQ(response.input, expected_input);
+      ASSERT_EQ(response.probability, policy_->value(step, cell));
+    }
+  }
+}
+
+TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const struct {
+    std::vector<double> state;
+    unsigned step;
+    const char* expected_word;
+  } cases[] = {{{1.0}, 0, "expected 2"},       {{1.0, 2.0, 3.0}, 0, "expected 2"}, {{nan, 0.0}, 0, "finite"},
+               {{0.0, inf}, 0, "finite"},      {{0.0, -inf}, 0, "finite"},        {{12.0, 0.0}, 0, "outside"},
+               {{0.0, -5.3}, 0, "outside"},    {{0.0, 0.0}, 14, "horizon"},       {{0.0, 0.0}, 1000, "horizon"},
+               {{}, 0, "expected 2"}};
+  for (const auto& c : cases) {
+    amytiss::GetInput::Response response;
+    response.input = {42.0};
+    amytiss_ros::fill_get_input_response(policy_, c.state, c.step, "", response);
+    EXPECT_FALSE(response.success);
+    EXPECT_TRUE(response.input.empty());
+    EXPECT_EQ(response.probability, 0.0);
+    EXPECT_NE(response.message.find(c.expected_word), std::string::npos) << response.message;
+  }
+}
+
+TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
+  amytiss::GetInput::Response response;
+  amytiss_ros::fill_get_input_response(nullptr, {0.0, 0.0}, 0, "synthesis is running (42%)", response);
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message, "no policy yet: synthesis is running (42%)");
+  EXPECT_TRUE(response.input.empty());
+}
+
+TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerialization) {
+  amytiss::StateStamped state;
+  state.header.stamp = ros::Time(12, 345);
+  state.header.frame_id = "map";
+  state.state = {-4.0, -4.1};
+  state.time_step = 3;
+  amytiss::InputCommand command;
+  amytiss_ros::fill_input_command(policy_, state, "", command);
+  ASSERT_TRUE(command.valid) << command.message;
+  EXPECT_EQ(command.header.stamp, state.header.stamp);
+  EXPECT_EQ(command.header.frame_id, "map");
+  EXPECT_EQ(command.time_step, 3u);
+  std::vector<double> expected(policy_->inputs.dims());
+  double probability = -1;
+  ASSERT_EQ(policy_->lookup(state.state.data(), 2, 3, expected.data(), &probability), amytiss::LookupStatus::Ok);
+  EXPECT_EQ(command.input, expected);
+  EXPECT_EQ(command.probability, probability);
+
+  // Through the wire format and back.
+  const uint32_t length = ros::serialization::serializationLength(command);
+  std::vector<uint8_t> buffer(length);
+  ros::serialization::OStream out(buffer.data(), length);
+  ros::serialization::serialize(out, command);
+  amytiss::InputCommand decoded;
+  ros::serialization::IStream in(buffer.data(), length);
+  ros::serialization::deserialize(in, decoded);
+  EXPECT_EQ(decoded, command);
+
+  state.time_step = policy_->horizon;
+  amytiss_ros::fill_input_command(policy_, state, "", command);
+  EXPECT_FALSE(command.valid);
+  EXPECT_TRUE(command.input.empty());
+  EXPECT_FALSE(command.message.empty());
+}
+
+TEST(ProgressConversions, FeedbackCarriesEveryField) {
+  amytiss::Progress progress;
+  progress.phase = "synthesis";
+  progress.steps_done = 7;
+  progress.steps_total = 16;
+  progress.device = "reference";
+  progress.elapsed_s = 1.5;
+  progress.remaining_s = 2.0;
+  const amytiss::SynthesizeFeedback feedback = amytiss_ros::feedback_from_progress(progress);
+  EXPECT_EQ(feedback.phase, "synthesis");
+  EXPECT_EQ(feedback.steps_done, 7u);
+  EXPECT_EQ(feedback.steps_total, 16u);
+  EXPECT_DOUBLE_EQ(feedback.percent, 43.75);
+  EXPECT_EQ(feedback.device, "reference");
+  EXPECT_EQ(feedback.remaining_s, 2.0);
+  EXPECT_EQ(amytiss_ros::describe_progress(progress),
+            "synthesis 44% (step 7/16) on reference, 1.5 s elapsed, about 2.0 s left");
+}
+
+TEST(Markers, GridBoundsTargetAndAvoid) {
+  const amytiss::Config config = amytiss::load_config_file(kTinyConfig);
+  const visualization_msgs::MarkerArray markers = amytiss_ros::make_set_markers(config, "map");
+  ASSERT_EQ(markers.markers.size(), 3u);
+  const auto& bounds = markers.markers[0];
+  EXPECT_EQ(bounds.ns, "grid_bounds");
+  ASSERT_EQ(bounds.points.size(), 5u);
+  EXPECT_DOUBLE_EQ(bounds.points[0].x, -5.25);
+  EXPECT_DOUBLE_EQ(bounds.points[2].y, 5.25);
+  const auto& target = markers.markers[1];
+  EXPECT_EQ(target.ns, "target");
+  EXPECT_DOUBLE_EQ(target.pose.position.x, 3.75);
+  EXPECT_DOUBLE_EQ(target.scale.y, 1.5);
+  EXPECT_EQ(markers.markers[2].ns, "avoid");
+  EXPECT_EQ(markers.markers[2].header.frame_id, "map");
+}
+
+TEST(PlantModel, SameSeedSameTrajectoryAndNoiseHasTheConfiguredCovariance) {
+  const amytiss::Config config = amytiss::load_config_file(kTinyConfig);
+  amytiss_ros::PlantModel first(config, 7), second(config, 7), other(config, 8);
+  const std::vector<double> state = {1.0, -2.0}, input = {0.0, 0.0};  // speed 0: f(x) = x
+  EXPECT_EQ(first.step(state, input), second.step(state, input));
+  EXPECT_NE(first.step(state, input), other.step(state, input));
+
+  constexpr int kSamples = 20000;
+  double sum = 0, sum_squares = 0;
+  for (int i = 0; i < kSamples; ++i) {
+    const double noise = first.step(state, input)[1] - state[1];
+    sum += noise;
+    sum_squares += noise * noise;
+  }
+  const double variance = config.noise.covariance[1];
+  const double mean = sum / kSamples;
+  EXPECT_LT(std::abs(mean), kStatisticsStandardErrors * std::sqrt(variance / kSamples));
+  // Var of the sample variance of a normal: 2 sigma^4 / N.
+  EXPECT_NEAR(sum_squares / kSamples, variance, kStatisticsStandardErrors * std::sqrt(2.0 / kSamples) * variance);
+}
+
+TEST(Outcomes, TextsPerSpecification) {
+  using amytiss_ros::StateClass;
+  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Target, 12).description,
+            "reached the target at step 12");
+  EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Target, 12).success);
+  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Unsafe, 3).description,
+            "entered the avoid set at step 3");
+  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Unsafe, 3).description,
+            "left the safe set at step 3");
+  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::OutsideGrid, 5).description,
+            "left the grid at step 5");
+  EXPECT_FALSE(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Free, 14).success);
+  EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Free, 8).success);
+}
+
+TEST(Outcomes, ClassifyByCellRole) {
+  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
+  amytiss::Policy policy;
+  policy.states = abstraction.states;
+  policy.roles = abstraction.roles;
+  EXPECT_EQ(amytiss_ros::classify_state(policy, {3.5, 4.0}), amytiss_ros::StateClass::Target);
+  EXPECT_EQ(amytiss_ros::classify_state(policy, {0.2, -0.9}), amytiss_ros::StateClass::Unsafe);
+  EXPECT_EQ(amytiss_ros::classify_state(policy, {-4.0, -4.0}), amytiss_ros::StateClass::Free);
+  EXPECT_EQ(amytiss_ros::classify_state(policy, {-5.3, 0.0}), amytiss_ros::StateClass::OutsideGrid);
+  EXPECT_EQ(amytiss_ros::classify_state(policy, {0.0}), amytiss_ros::StateClass::OutsideGrid);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
