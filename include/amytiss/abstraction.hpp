@@ -35,6 +35,10 @@ struct Abstraction {
 
   /// Validates and builds. Throws ConfigError.
   static Abstraction from_config(const Config& config);
+  /// Builds from a configuration and given dynamics (tests: lambda dynamics) without calling
+  /// Config::validate() or make_dynamics(); still checks what it uses (grids, noise, sets, horizon,
+  /// the dynamics' dimensions) and throws ConfigError.
+  static Abstraction from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics);
 
   /// V_{T_d} of a cell with the given role.
   double terminal_value(CellRole role) const;
@@ -42,5 +46,12 @@ struct Abstraction {
   std::size_t pairs() const { return states.size() * inputs.size(); }
   std::size_t triples() const { return pairs() * disturbances.size(); }
 };
+
+/// Roles of the state cells for a specification (a cell is in a set when its point lies in the
+/// closed box). Safety: outside `safe` -> FixedZero (no `safe`: all Free). Reachability: target ->
+/// FixedOne. Reach-avoid: avoid -> FixedZero, target -> FixedOne; a cell in both (a configuration
+/// error that validate() rejects) is FixedZero: avoid is applied first and wins.
+/// Throws ConfigError for a missing target or a box of the wrong dimension.
+std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec);
 
 }  // namespace amytiss

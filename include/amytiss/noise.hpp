@@ -30,6 +30,9 @@ namespace amytiss {
 
 class NoiseModel {
  public:
+  static constexpr std::size_t kMaxFullCovarianceDims = 4;
+  static constexpr std::size_t kGaussLegendreOrder = 8;
+
   /// Throws ConfigError for a covariance that is not symmetric positive definite, etc.
   NoiseModel(const NoiseConfig& config, const Grid& states);
 
@@ -60,6 +63,14 @@ class NoiseModel {
 
   /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
   /// bound documented in noise.cpp and README ("Full covariance"); |error| <= box_mass_tolerance().
+  /// Method: sequential conditioning x = mean + L z (L Cholesky, z standard normal), nested
+  /// composite Gauss-Legendre over z_0..z_{n-2} (panel width <= 1 standard deviation, narrowed
+  /// where later bounds depend steeply on z_i), exact erfc for z_{n-1}, z clipped to |z| <= 9.
+  /// The tolerance is measured at construction: 10 x the largest difference between order
+  /// kGaussLegendreOrder and twice that order on sample boxes (cells of this grid around random
+  /// means), plus the clipped tail mass. Full covariance is supported up to
+  /// kMaxFullCovarianceDims dimensions (the cost grows like (points per level)^(n-1)). For a
+  /// separable model this is the exact product of interval masses.
   double box_mass(const double* lo, const double* hi, const double* mean) const;
   double box_mass_tolerance() const { return box_mass_tolerance_; }
 
@@ -80,8 +91,16 @@ class NoiseModel {
   std::vector<double> base_scale_;
   std::vector<double> covariance_;       // full n*n, row-major
   std::vector<double> cholesky_;         // lower triangular, row-major (full covariance)
-  std::vector<double> eta_;
+  std::vector<double> lb_, eta_;        // the state grid's (cell bounds lb + (k -+ 1/2)*eta)
+  std::vector<std::size_t> counts_;     // the state grid's points per dimension
   std::vector<std::int64_t> window_half_cells_;
+  bool whole_grid_window_ = false;      // truncation none: every window is the whole grid
+  // Full covariance quadrature (see noise.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
+  // panel width per conditioning level in standard-normal units.
+  std::vector<double> legendre_nodes_, legendre_weights_;
+  std::vector<double> panel_width_;
+  double box_mass_with(const double* lo, const double* hi, const double* mean,
+                       const std::vector<double>& nodes, const std::vector<double>& weights) const;
   double cut_mass_bound_ = 0.0;
   double box_mass_tolerance_ = 0.0;
   std::size_t grid_size_ = 1;

@@ -1,0 +1,115 @@
+#include "amytiss/policy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace amytiss {
+namespace {
+
+std::string format_number(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.10g", value);
+  return buffer;
+}
+
+std::string format_state(const double* state, std::size_t length) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < length; ++i) {
+    if (i) text += ", ";
+    text += format_number(state[i]);
+  }
+  return text + "]";
+}
+
+std::string component_names(std::size_t dims) {
+  std::string text = "(";
+  for (std::size_t i = 0; i < dims; ++i) text += (i ? ", x" : "x") + std::to_string(i);
+  return text + ")";
+}
+
+// The covered interval of dimension d: [lb - eta/2, last + eta/2].
+std::string covered_interval(const Grid& grid, std::size_t d) {
+  const double low = grid.lb()[d] - 0.5 * grid.eta()[d];
+  const double high = grid.coordinate(d, grid.count(d) - 1) + 0.5 * grid.eta()[d];
+  return "[" + format_number(low) + ", " + format_number(high) + "]";
+}
+
+}  // namespace
+
+LookupStatus Policy::lookup(const double* state, std::size_t state_length, unsigned step,
+                            double* input_out, double* probability_out) const {
+  if (state_length != states.dims()) return LookupStatus::WrongDimension;
+  for (std::size_t i = 0; i < state_length; ++i)
+    if (!std::isfinite(state[i])) return LookupStatus::NotFinite;
+  if (step >= horizon) return LookupStatus::StepBeyondHorizon;
+  const auto cell = states.cell_of(state);
+  if (!cell) return LookupStatus::OutsideGrid;
+  inputs.point(input(step, *cell), input_out);
+  *probability_out = value(step, *cell);
+  return LookupStatus::Ok;
+}
+
+std::string Policy::describe(LookupStatus status, const double* state, std::size_t state_length,
+                             unsigned step) const {
+  switch (status) {
+    case LookupStatus::Ok:
+      return "ok";
+    case LookupStatus::WrongDimension:
+      return "state has " + std::to_string(state_length) + " value" + (state_length == 1 ? "" : "s") +
+             ", expected " + std::to_string(states.dims()) + " " + component_names(states.dims());
+    case LookupStatus::NotFinite: {
+      std::string which;
+      for (std::size_t i = 0; i < state_length; ++i)
+        if (!std::isfinite(state[i])) {
+          which = "x" + std::to_string(i) + " = " + format_number(state[i]);
+          break;
+        }
+      return "state " + format_state(state, state_length) + " is not finite (" + which +
+             "), expected finite numbers";
+    }
+    case LookupStatus::OutsideGrid: {
+      std::string grid_text, which;
+      for (std::size_t d = 0; d < states.dims(); ++d) {
+        grid_text += (d ? " x " : "") + covered_interval(states, d);
+        if (which.empty() && d < state_length) {
+          const double low = states.lb()[d] - 0.5 * states.eta()[d];
+          const double high = states.coordinate(d, states.count(d) - 1) + 0.5 * states.eta()[d];
+          if (!(state[d] >= low && state[d] <= high))
+            which = "x" + std::to_string(d) + " = " + format_number(state[d]) + " is not in " +
+                    covered_interval(states, d);
+        }
+      }
+      return "state " + format_state(state, state_length) + " is outside the grid " + grid_text +
+             (which.empty() ? "" : " (" + which + ")");
+    }
+    case LookupStatus::StepBeyondHorizon:
+      return "time_step " + std::to_string(step) + " is beyond the horizon, expected 0 <= time_step < " +
+             std::to_string(horizon);
+  }
+  return "unknown lookup status";
+}
+
+ValueSummary summarize_initial_values(const Policy& policy) {
+  ValueSummary summary;
+  double sum = 0;
+  const std::size_t cells = policy.states.size();
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    if (cell < policy.roles.size() && policy.roles[cell] != CellRole::Free) continue;
+    const double value = policy.value(0, cell);
+    if (summary.free_cells == 0) {
+      summary.min = summary.max = value;
+    } else {
+      summary.min = std::min(summary.min, value);
+      summary.max = std::max(summary.max, value);
+    }
+    sum += value;
+    ++summary.free_cells;
+    if (value >= 0.5) ++summary.cells_at_least_half;
+  }
+  if (summary.free_cells) summary.mean = sum / double(summary.free_cells);
+  return summary;
+}
+
+}  // namespace amytiss

@@ -1,0 +1,196 @@
+#pragma once
+// Helpers for tests: tiny Abstractions built by hand with lambda dynamics, without expressions or
+// built-in models. Other areas' tests use these; keep the interface stable.
+//
+//   using namespace amytiss::test_support;
+//   auto dynamics = std::make_shared<LambdaDynamics>(1, 1, 0,
+//       [](const double* x, const double* u, const double*, double* post) { post[0] = x[0] + u[0]; },
+//       "post[0] = x[0] + u[0];");                       // optional OpenCL C body
+//   Config config = make_config(grid_spec({-1}, {1}, {0.5}), grid_spec({-0.5}, {0.5}, {0.5}),
+//                               std::nullopt, normal_noise({0.09}), safety_spec(2));
+//   Abstraction abstraction = Abstraction::from_parts(config, dynamics);
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/model.hpp"
+
+namespace amytiss {
+namespace test_support {
+
+/// Dynamics from a C++ callable. `opencl_body` is the body of amytiss_dynamics in OpenCL C (the
+/// statements that fill post[] from x[], u[], w[]); empty when the test never runs OpenCL.
+class LambdaDynamics : public Dynamics {
+ public:
+  using Function = std::function<void(const double* x, const double* u, const double* w, double* post)>;
+  LambdaDynamics(std::size_t state_dims, std::size_t input_dims, std::size_t disturbance_dims,
+                 Function function, std::string opencl_body = "")
+      : state_dims_(state_dims),
+        input_dims_(input_dims),
+        disturbance_dims_(disturbance_dims),
+        function_(std::move(function)),
+        opencl_body_(std::move(opencl_body)) {}
+  std::size_t state_dims() const override { return state_dims_; }
+  std::size_t input_dims() const override { return input_dims_; }
+  std::size_t disturbance_dims() const override { return disturbance_dims_; }
+  void evaluate(const double* x, const double* u, const double* w, double* post) const override {
+    function_(x, u, w, post);
+  }
+  std::string opencl_source() const override {
+    return "void amytiss_dynamics(const double* x, const double* u, const double* w, double* post) {\n" +
+           opencl_body_ + "\n}\n";
+  }
+  std::string describe() const override { return "test lambda dynamics"; }
+  const std::string& opencl_body() const { return opencl_body_; }
+
+ private:
+  std::size_t state_dims_, input_dims_, disturbance_dims_;
+  Function function_;
+  std::string opencl_body_;
+};
+
+inline GridSpec grid_spec(std::vector<double> lb, std::vector<double> ub, std::vector<double> eta) {
+  GridSpec spec;
+  spec.lb = std::move(lb);
+  spec.ub = std::move(ub);
+  spec.eta = std::move(eta);
+  return spec;
+}
+
+inline Box box(std::vector<double> lb, std::vector<double> ub) {
+  Box result;
+  result.lb = std::move(lb);
+  result.ub = std::move(ub);
+  return result;
+}
+
+/// Additive normal noise; covariance: n values (diagonal) or n*n (full).
+inline NoiseConfig normal_noise(std::vector<double> covariance, Truncation truncation = Truncation::None,
+                                double cutting_probability = 1e-3, std::vector<double> fixed_region = {}) {
+  NoiseConfig noise;
+  noise.type = NoiseType::Additive;
+  noise.distribution = Distribution::Normal;
+  noise.covariance = std::move(covariance);
+  noise.truncation = truncation;
+  noise.cutting_probability = cutting_probability;
+  noise.fixed_region = std::move(fixed_region);
+  return noise;
+}
+
+/// Additive uniform noise on [-h, h] per dimension.
+inline NoiseConfig uniform_noise(std::vector<double> half_width, Truncation truncation = Truncation::None) {
+  NoiseConfig noise;
+  noise.type = NoiseType::Additive;
+  noise.distribution = Distribution::Uniform;
+  noise.half_width = std::move(half_width);
+  noise.truncation = truncation;
+  return noise;
+}
+
+inline SpecConfig safety_spec(unsigned horizon, std::optional<Box> safe = std::nullopt) {
+  SpecConfig spec;
+  spec.type = SpecType::Safety;
+  spec.horizon = horizon;
+  spec.safe = std::move(safe);
+  return spec;
+}
+
+inline SpecConfig reach_avoid_spec(unsigned horizon, Box target, std::optional<Box> avoid = std::nullopt) {
+  SpecConfig spec;
+  spec.type = avoid ? SpecType::ReachAvoid : SpecType::Reachability;
+  spec.horizon = horizon;
+  spec.target = std::move(target);
+  spec.avoid = std::move(avoid);
+  return spec;
+}
+
+/// A Config for from_parts. `description` goes into config.dynamics[0] only so that different
+/// test problems get different config hashes (it is never parsed).
+inline Config make_config(GridSpec states, std::optional<GridSpec> inputs, std::optional<GridSpec> disturbances,
+                          NoiseConfig noise, SpecConfig spec, const std::string& description = "test") {
+  Config config;
+  config.name = "test";
+  config.states = std::move(states);
+  config.inputs = std::move(inputs);
+  config.disturbances = std::move(disturbances);
+  config.noise = std::move(noise);
+  config.spec = std::move(spec);
+  config.dynamics = {description};
+  config.compute.device = DeviceKind::Reference;
+  return config;
+}
+
+inline Abstraction make_abstraction(const Config& config, std::shared_ptr<const Dynamics> dynamics) {
+  return Abstraction::from_parts(config, std::move(dynamics));
+}
+
+/// A random affine system post = A x + B u + C w + c (fixed seed), with its OpenCL body, on a grid
+/// of `cells_per_dim` points per state dimension over [-1, 1], inputs 3 points per dimension over
+/// [-0.5, 0.5], and 2 disturbance points in [-0.2, 0.2] when `with_disturbance`. Diagonal normal
+/// noise with standard deviation 0.3 and the given truncation. A contraction (|A| entries small)
+/// keeps mass on the grid so that the values are not trivially 0.
+inline Abstraction random_affine_abstraction(std::uint64_t seed, std::size_t state_dims, std::size_t input_dims,
+                                             bool with_disturbance, SpecConfig spec,
+                                             std::size_t cells_per_dim = 5,
+                                             Truncation truncation = Truncation::CuttingProbability) {
+  std::mt19937_64 generator(seed);
+  std::uniform_real_distribution<double> coefficient(-0.4, 0.4);
+  const std::size_t disturbance_dims = with_disturbance ? 1 : 0;
+  std::vector<double> a(state_dims * state_dims), b(state_dims * input_dims), c(state_dims * disturbance_dims),
+      offset(state_dims);
+  for (auto& value : a) value = coefficient(generator);
+  for (std::size_t i = 0; i < state_dims; ++i) a[i * state_dims + i] += 0.5;
+  for (auto& value : b) value = 2.0 * coefficient(generator);
+  for (auto& value : c) value = coefficient(generator);
+  for (auto& value : offset) value = 0.25 * coefficient(generator);
+  auto print = [](double value) {
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    return std::string(buffer);
+  };
+  std::string body;
+  for (std::size_t i = 0; i < state_dims; ++i) {
+    body += "post[" + std::to_string(i) + "] = " + print(offset[i]);
+    for (std::size_t j = 0; j < state_dims; ++j)
+      body += " + " + print(a[i * state_dims + j]) + " * x[" + std::to_string(j) + "]";
+    for (std::size_t j = 0; j < input_dims; ++j)
+      body += " + " + print(b[i * input_dims + j]) + " * u[" + std::to_string(j) + "]";
+    for (std::size_t j = 0; j < disturbance_dims; ++j)
+      body += " + " + print(c[i * disturbance_dims + j]) + " * w[" + std::to_string(j) + "]";
+    body += ";\n";
+  }
+  auto function = [=](const double* x, const double* u, const double* w, double* post) {
+    for (std::size_t i = 0; i < state_dims; ++i) {
+      double sum = offset[i];
+      for (std::size_t j = 0; j < state_dims; ++j) sum += a[i * state_dims + j] * x[j];
+      for (std::size_t j = 0; j < input_dims; ++j) sum += b[i * input_dims + j] * u[j];
+      for (std::size_t j = 0; j < disturbance_dims; ++j) sum += c[i * disturbance_dims + j] * w[j];
+      post[i] = sum;
+    }
+  };
+  auto dynamics = std::make_shared<LambdaDynamics>(state_dims, input_dims, disturbance_dims, function, body);
+  const double eta = 2.0 / double(cells_per_dim - 1);
+  std::optional<GridSpec> inputs;
+  if (input_dims)
+    inputs = grid_spec(std::vector<double>(input_dims, -0.5), std::vector<double>(input_dims, 0.5),
+                       std::vector<double>(input_dims, 0.5));
+  std::optional<GridSpec> disturbances;
+  if (with_disturbance) disturbances = grid_spec({-0.2}, {0.2}, {0.4});
+  Config config = make_config(grid_spec(std::vector<double>(state_dims, -1.0), std::vector<double>(state_dims, 1.0),
+                                        std::vector<double>(state_dims, eta)),
+                              inputs, disturbances,
+                              normal_noise(std::vector<double>(state_dims, 0.09), truncation, 1e-3),
+                              std::move(spec), "random affine seed " + std::to_string(seed) + ": " + body);
+  return Abstraction::from_parts(config, dynamics);
+}
+
+}  // namespace test_support
+}  // namespace amytiss
