@@ -1,0 +1,282 @@
+// amytiss OpenCL engine: MDP construction (stored transitions), synthesis sweep (stored and
+// on-the-fly). One algorithm for every device; the host prepends a generated prelude that
+// defines the problem as compile-time constants (see opencl_program.cpp) and the system's
+// amytiss_dynamics(), and appends nothing.
+//
+// Prelude contract (all numbers printed by the host with 17 significant digits):
+//   STATE_DIMS, INPUT_DIMS, DIST_DIMS         dimensions (INPUT/DIST may be 0)
+//   N_STATES, N_INPUTS, N_DISTS               grid sizes (1 for a zero-dimensional grid)
+//   MASS_RECORD                               sum_i (2 h_i + 1): floats of one transition record
+//   BOUNDS_CAPACITY                           max_i (2 h_i + 2) rounded up to a multiple of 8
+//   MULTIPLICATIVE (0/1), UNIFORM (0/1: 0 = normal), TRUNCATION_NONE (0/1), ON_THE_FLY (0/1)
+//   GROUP_SIZE                                work-items per group of synthesize_group
+//   __constant arrays (length max(1, dims)): STATE_LB, STATE_ETA (double), STATE_COUNT,
+//   HALF_CELLS, WIDTH, MASS_OFFSET, PADDED_STRIDE (int); KEEP_HALF (long: NoiseModel's h); INPUT_LB, INPUT_ETA, INPUT_COUNT;
+//   DIST_LB, DIST_ETA, DIST_COUNT; NOISE_SCALE (double, the additive scale per dimension).
+//   float contract(__global const float* v, const float* m): the separable contraction
+//     sum_a0 m[a0] * (sum_a1 m[MASS_OFFSET[1] + a1] * (... v[a0*PADDED_STRIDE[0] + ...])),
+//     generated with the window widths as literal trip counts.
+//
+// Value layout: V lives in a padded array, each dimension extended by h_i zero cells on both
+// sides, so a window never needs clipping in the sweep: a transition record is the padded flat
+// offset of its window's first cell plus its per-dimension masses (zero where the window leaves
+// the grid or the truncation region).
+
+// Point of a flat (row-major, last dimension fastest) grid index.
+void grid_point(ulong flat, int dims, __constant double* lb, __constant double* eta,
+                __constant int* count, double* out) {
+  for (int dim = dims - 1; dim >= 0; --dim) {
+    ulong k = flat % (ulong)count[dim];
+    flat /= (ulong)count[dim];
+    out[dim] = lb[dim] + (double)k * eta[dim];
+  }
+}
+
+// Padded flat offset of the state cell with the given flat index.
+uint padded_offset(uint state) {
+  uint offset = 0;
+  for (int dim = STATE_DIMS - 1; dim >= 0; --dim) {
+    uint k = state % (uint)STATE_COUNT[dim];
+    state /= (uint)STATE_COUNT[dim];
+    offset += (k + (uint)HALF_CELLS[dim]) * (uint)PADDED_STRIDE[dim];
+  }
+  return offset;
+}
+
+// erfc(z) for z >= 0: Chebyshev expansion of Numerical Recipes 3rd ed. (Erf::erfccheb).
+// Measured against glibc erfc on [0, 27] in steps of 1e-4: absolute error <= 5e-16, far below
+// the float the masses are stored in; several times faster than the OpenCL library erfc on pocl.
+__constant double ERFC_COEFFICIENTS[28] = {
+    -1.3026537197817094, 6.4196979235649026e-1, 1.9476473204185836e-2, -9.561514786808631e-3,
+    -9.46595344482036e-4, 3.66839497852761e-4, 4.2523324806907e-5, -2.0278578112534e-5,
+    -1.624290004647e-6, 1.303655835580e-6, 1.5626441722e-8, -8.5238095915e-8,
+    6.529054439e-9, 5.059343495e-9, -9.91364156e-10, -2.27365122e-10,
+    9.6467911e-11, 2.394038e-12, -6.886027e-12, 8.94487e-13,
+    3.13092e-13, -1.12708e-13, 3.81e-16, 7.106e-15,
+    -1.523e-15, -9.4e-17, 1.21e-16, -2.8e-17};
+// Eight at a time: the recurrence is a serial dependency chain, so lanes are what makes it fast.
+double8 erfc_nonnegative8(double8 z) {
+  const double8 t = 2.0 / (2.0 + z), ty = 4.0 * t - 2.0;
+  double8 d = 0.0, dd = 0.0;
+  for (int j = 27; j > 0; --j) {
+    const double8 previous = d;
+    // One fma on the dependency chain; the subtraction uses the value of an earlier iteration.
+    d = fma(ty, d, ERFC_COEFFICIENTS[j] - dd);
+    dd = previous;
+  }
+  return t * exp(-z * z + 0.5 * (ERFC_COEFFICIENTS[0] + ty * d) - dd);
+}
+
+// Mass of [lo, hi] under the 1-d law with the given mean and scale (normal: standard deviation,
+// uniform: half-width). Scale 0 is a point mass, 1 when lo <= mean < hi (as NoiseModel).
+double interval_mass(double lo, double hi, double mean, double scale) {
+  if (scale <= 0.0) return (lo <= mean && mean < hi) ? 1.0 : 0.0;
+#if UNIFORM
+  double overlap = fmin(hi, mean + scale) - fmax(lo, mean - scale);
+  return overlap > 0.0 ? fmin(1.0, overlap / (2.0 * scale)) : 0.0;
+#else
+  double inverse = 1.0 / (scale * 1.4142135623730951);
+  return 0.5 * (erfc((lo - mean) * inverse) - erfc((hi - mean) * inverse));
+#endif
+}
+
+// Transition record of the triple (state, input, disturbance): post mean computed once, window
+// placed in double exactly as Grid::nearest, masses in double rounded to float. Returns the
+// padded offset of the window's first cell; writes MASS_RECORD masses to m.
+uint compute_record(ulong state, ulong input, ulong disturbance, float* m) {
+  double x[STATE_DIMS], post[STATE_DIMS];
+  double u[INPUT_DIMS > 0 ? INPUT_DIMS : 1];
+  double w[DIST_DIMS > 0 ? DIST_DIMS : 1];
+  u[0] = 0.0;
+  w[0] = 0.0;
+  grid_point(state, STATE_DIMS, STATE_LB, STATE_ETA, STATE_COUNT, x);
+  grid_point(input, INPUT_DIMS, INPUT_LB, INPUT_ETA, INPUT_COUNT, u);
+  grid_point(disturbance, DIST_DIMS, DIST_LB, DIST_ETA, DIST_COUNT, w);
+  amytiss_dynamics(x, u, w, post);
+
+  uint offset = 0;
+  for (int dim = 0; dim < STATE_DIMS; ++dim) {
+    const int count = STATE_COUNT[dim];
+    const int half_cells = HALF_CELLS[dim];
+    const double eta = STATE_ETA[dim];
+    const double mean = post[dim];
+#if MULTIPLICATIVE
+    const double scale = NOISE_SCALE[dim] * fabs(x[dim]);
+#else
+    const double scale = NOISE_SCALE[dim];
+#endif
+    // A non-finite post state has no cell: all its mass leaves the grid.
+    const bool finite = isfinite(mean);
+    // Truncation keeps nearest +- KEEP_HALF (NoiseModel's h, which may exceed the grid; the
+    // layout's half_cells is capped at count - 1). Clamp before converting so that far-away
+    // means cannot overflow the integer: beyond this range nothing is kept either way.
+    const long keep_half = KEEP_HALF[dim];
+    double nearest_real = floor((mean - STATE_LB[dim]) / eta + 0.5);
+    nearest_real = fmax(fmin(nearest_real, (double)(count + keep_half + 1)), (double)(-keep_half - 2));
+    const long nearest = finite ? (long)nearest_real : -keep_half - 2;
+    const int start = (int)clamp(nearest, 0L, (long)(count - 1));
+#if TRUNCATION_NONE
+    const int keep_first = 0, keep_last = finite ? count - 1 : -1;
+#else
+    const int keep_first = (int)max(nearest - keep_half, 0L);
+    const int keep_last = (int)min(nearest + keep_half, (long)(count - 1));
+#endif
+#if UNIFORM
+    for (int j = 0; j < WIDTH[dim]; ++j) {
+      const int k = start - half_cells + j;
+      double mass = 0.0;
+      if (k >= keep_first && k <= keep_last) {
+        // The bounds as NoiseModel::cell_mass writes them: neighbours share a bound exactly.
+        mass = interval_mass(STATE_LB[dim] + ((double)k - 0.5) * eta,
+                             STATE_LB[dim] + ((double)k + 0.5) * eta, mean, scale);
+      }
+      m[MASS_OFFSET[dim] + j] = (float)mass;
+    }
+#else
+    // Normal law: one erfc per cell bound (not two per cell). tail(b) is the mass beyond b on
+    // the far side of the mean, so every difference below subtracts tails on one side and is
+    // accurate to ~1e-16 in absolute terms, far below the float the mass is stored in.
+    const double inverse = scale > 0.0 ? 1.0 / (scale * 1.4142135623730951) : 0.0;
+    double bound[BOUNDS_CAPACITY], tail[BOUNDS_CAPACITY];
+    for (int b = 0; b < BOUNDS_CAPACITY; ++b) {
+      bound[b] = STATE_LB[dim] + ((double)(start - half_cells + b) - 0.5) * eta;
+      tail[b] = fabs(bound[b] - mean) * inverse;
+    }
+    for (int b = 0; b <= WIDTH[dim]; b += 8)
+      vstore8(0.5 * erfc_nonnegative8(vload8(0, tail + b)), 0, tail + b);
+    for (int j = 0; j < WIDTH[dim]; ++j) {
+      const int k = start - half_cells + j;
+      const double lo = bound[j], hi = bound[j + 1];
+      double mass;
+      if (scale <= 0.0) mass = (lo <= mean && mean < hi) ? 1.0 : 0.0;
+      else if (lo >= mean) mass = tail[j] - tail[j + 1];
+      else if (hi <= mean) mass = tail[j + 1] - tail[j];
+      else mass = 1.0 - tail[j] - tail[j + 1];
+      m[MASS_OFFSET[dim] + j] = (k >= keep_first && k <= keep_last) ? (float)mass : 0.0f;
+    }
+#endif
+    // Padded index of grid cell start - half is start.
+    offset += (uint)start * (uint)PADDED_STRIDE[dim];
+  }
+  return offset;
+}
+
+// Algorithm 2: one record per (state, input, disturbance) triple of a chunk of states.
+__kernel void construct(ulong triple_begin, ulong triple_count, __global uint* starts,
+                        __global float* masses) {
+  const ulong local_triple = get_global_id(0);
+  if (local_triple >= triple_count) return;
+  const ulong triple = triple_begin + local_triple;
+  const ulong disturbance = triple % N_DISTS;
+  const ulong pair = triple / N_DISTS;
+  float m[MASS_RECORD];
+  starts[local_triple] = compute_record(pair / N_INPUTS, pair % N_INPUTS, disturbance, m);
+  __global float* out = masses + local_triple * MASS_RECORD;
+  for (int j = 0; j < MASS_RECORD; ++j) out[j] = m[j];
+}
+
+// min over disturbances of the expected next value for (state, input); stops as soon as the
+// minimum cannot beat `bar` (the best value of a lower input), which cannot change the argmax.
+float input_value(__global const float* v, uint state, uint local_state, uint input, float bar,
+                  __global const uint* starts, __global const float* masses) {
+  float worst = INFINITY;
+  for (uint disturbance = 0; disturbance < N_DISTS; ++disturbance) {
+    float m[MASS_RECORD];
+    uint start;
+#if ON_THE_FLY
+    start = compute_record(state, input, disturbance, m);
+#else
+    const ulong record = ((ulong)local_state * N_INPUTS + input) * N_DISTS + disturbance;
+    start = starts[record];
+    __global const float* stored = masses + record * MASS_RECORD;
+    for (int j = 0; j < MASS_RECORD; ++j) m[j] = stored[j];
+#endif
+    worst = fmin(worst, contract(v + start, m));
+    if (worst <= bar) break;
+  }
+  return worst;
+}
+
+// Fixed cells keep their value; returns true when the state is Free.
+bool handle_fixed(uint state, uint offset, __global const uchar* roles, __global float* v_next,
+                  __global uint* best_input) {
+  const uchar role = roles[state];
+  if (role == 0) return true;
+  v_next[offset] = role == 2 ? 1.0f : 0.0f;
+  best_input[state] = 0;
+  return false;
+}
+
+// Algorithm 4, one work-item per state (CPU: each work-item streams its own records).
+// Chunk: states state_begin .. state_begin + state_count; starts/masses hold that chunk's records.
+__kernel void synthesize_item(__global const float* v, __global float* v_next,
+                              __global uint* best_input, __global const uchar* roles,
+                              uint state_begin, uint state_count, __global const uint* starts,
+                              __global const float* masses) {
+  const uint local_state = get_global_id(0);
+  if (local_state >= state_count) return;
+  const uint state = state_begin + local_state;
+  const uint offset = padded_offset(state);
+  if (!handle_fixed(state, offset, roles, v_next, best_input)) return;
+  float best = -1.0f;
+  uint best_index = 0;
+  for (uint input = 0; input < N_INPUTS; ++input) {
+    const float value = input_value(v, state, local_state, input, best, starts, masses);
+    if (value > best) {
+      best = value;
+      best_index = input;
+    }
+  }
+  v_next[offset] = best;
+  best_input[state] = best_index;
+}
+
+// Algorithm 4, one work-group per state, its work-items over inputs, argmax in local memory
+// (GPU: many inputs in flight per state). Same input_value(), same tie rule (lowest index), so
+// the result is bit-identical to synthesize_item.
+__kernel __attribute__((reqd_work_group_size(GROUP_SIZE, 1, 1)))
+void synthesize_group(__global const float* v, __global float* v_next,
+                      __global uint* best_input, __global const uchar* roles, uint state_begin,
+                      uint state_count, __global const uint* starts,
+                      __global const float* masses) {
+  __local float group_value[GROUP_SIZE];
+  __local uint group_index[GROUP_SIZE];
+  const uint local_state = get_group_id(0);
+  const uint lane = get_local_id(0);
+  if (local_state >= state_count) return;  // uniform over the group
+  const uint state = state_begin + local_state;
+  const uint offset = padded_offset(state);
+  if (roles[state] != 0) {
+    if (lane == 0) handle_fixed(state, offset, roles, v_next, best_input);
+    return;  // uniform over the group
+  }
+  float best = -1.0f;
+  uint best_index = 0xffffffffu;
+  for (uint input = lane; input < N_INPUTS; input += GROUP_SIZE) {
+    // Pruning against this lane's best of lower inputs keeps the argmax exact.
+    const float value = input_value(v, state, local_state, input, best, starts, masses);
+    if (value > best) {
+      best = value;
+      best_index = input;
+    }
+  }
+  group_value[lane] = best;
+  group_index[lane] = best_index;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint stride = GROUP_SIZE / 2; stride > 0; stride /= 2) {
+    if (lane < stride) {
+      const float other = group_value[lane + stride];
+      const uint other_index = group_index[lane + stride];
+      if (other > group_value[lane] ||
+          (other == group_value[lane] && other_index < group_index[lane])) {
+        group_value[lane] = other;
+        group_index[lane] = other_index;
+      }
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (lane == 0) {
+    v_next[offset] = group_value[0];
+    best_input[state] = group_index[0];
+  }
+}

@@ -1,0 +1,404 @@
+// The OpenCL engine (on pocl here) against the serial reference engine, and its own invariants:
+// stored == on-the-fly, work-item == work-group sweep, chunked == unchunked, device listing,
+// cancellation, reports.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
+#include "opencl_engine.hpp"
+#include "test_support.hpp"
+
+namespace amytiss {
+namespace {
+
+using namespace test_support;
+using detail::OpenClEngineOptions;
+using detail::SweepVariant;
+
+// Values are computed in float from float masses (docs/engine.md bounds the error by
+// horizon * (window length + depth) * 2^-24); the product contract asks for 1e-5.
+constexpr double kValueTolerance = 1e-5;
+// Inputs must agree wherever the best input beats the chosen one by more than this.
+constexpr double kInputMarginTolerance = 1e-5;
+
+Abstraction from_yaml(const std::string& text) {
+  return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
+}
+
+// Expected next value of (state, input) under V_{step+1} of `policy`, min over disturbances,
+// evaluated directly in double from the noise model (independent of both engines' loops).
+double input_value(const Abstraction& a, const Policy& policy, unsigned step, std::size_t state,
+                   std::size_t input) {
+  const std::size_t dims = a.states.dims();
+  const std::vector<double> x = a.states.point(state), u = a.inputs.point(input);
+  const double* next = &policy.values[std::size_t(step + 1) * a.states.size()];
+  double worst = std::numeric_limits<double>::infinity();
+  for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
+    const std::vector<double> disturbance = a.disturbances.point(w);
+    std::vector<double> mean(dims);
+    a.dynamics->evaluate(x.data(), u.data(), disturbance.data(), mean.data());
+    std::vector<std::int64_t> first(dims), last(dims);
+    double expected = 0.0;
+    if (a.noise->window(a.states, mean.data(), first.data(), last.data())) {
+      std::vector<std::size_t> multi(dims);
+      for (std::size_t d = 0; d < dims; ++d) multi[d] = std::size_t(first[d]);
+      while (true) {
+        double probability = 1.0;
+        for (std::size_t d = 0; d < dims; ++d)
+          probability *= a.noise->cell_mass(d, multi[d], mean[d], a.noise->scale(d, x.data()));
+        expected += probability * next[a.states.flat_index(multi.data())];
+        std::size_t d = dims;
+        while (d-- > 0) {
+          if (std::int64_t(++multi[d]) <= last[d]) break;
+          multi[d] = std::size_t(first[d]);
+        }
+        if (d == std::size_t(-1)) break;
+      }
+    }
+    worst = std::min(worst, expected);
+  }
+  return worst;
+}
+
+struct Agreement {
+  double max_value_difference = 0;
+  std::size_t input_mismatches = 0;       // cells whose chosen inputs differ
+  double max_mismatch_margin = 0;         // largest q(reference input) - q(opencl input) there
+};
+
+Agreement compare(const Abstraction& a, const Policy& reference, const Policy& opencl) {
+  Agreement result;
+  EXPECT_EQ(reference.values.size(), opencl.values.size());
+  EXPECT_EQ(reference.input_index.size(), opencl.input_index.size());
+  for (std::size_t i = 0; i < reference.values.size(); ++i)
+    result.max_value_difference =
+        std::max(result.max_value_difference, std::fabs(reference.values[i] - opencl.values[i]));
+  for (unsigned step = 0; step < a.horizon; ++step)
+    for (std::size_t cell = 0; cell < a.states.size(); ++cell) {
+      const auto chosen_reference = reference.input(step, cell), chosen_opencl = opencl.input(step, cell);
+      if (chosen_reference == chosen_opencl) continue;
+      ++result.input_mismatches;
+      const double margin = input_value(a, reference, step, cell, chosen_reference) -
+                            input_value(a, reference, step, cell, chosen_opencl);
+      result.max_mismatch_margin = std::max(result.max_mismatch_margin, margin);
+    }
+  return result;
+}
+
+SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::Auto) {
+  SynthesisOptions options;
+  options.compute.device = DeviceKind::Cpu;
+  options.compute.transitions = transitions;
+  return options;
+}
+
+double seconds_of(const SynthesisReport& report) {
+  double total = 0;
+  for (const auto& phase : report.phases)
+    if (phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
+  return total;
+}
+
+// Runs both engines, checks the contract, prints the figures.
+void expect_agreement(const std::string& label, const Abstraction& a,
+                      TransitionStorage transitions = TransitionStorage::Auto) {
+  const auto reference_start = std::chrono::steady_clock::now();
+  const Policy reference = synthesize_reference(a, {}, nullptr);
+  const double reference_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - reference_start).count();
+  SynthesisReport report;
+  const Policy opencl = synthesize(a, cpu_options(transitions), &report);
+  const Agreement agreement = compare(a, reference, opencl);
+  std::printf("[%s] pairs %zu, max |dV| %.3g, input mismatches %zu (max margin %.3g), reference %.3f s, "
+              "opencl %.3f s (%s)\n",
+              label.c_str(), a.pairs(), agreement.max_value_difference, agreement.input_mismatches,
+              agreement.max_mismatch_margin, reference_seconds, seconds_of(report),
+              report.transitions.c_str());
+  EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label;
+  EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
+  // Values are probabilities.
+  for (double value : opencl.values) {
+    ASSERT_GE(value, 0.0);
+    ASSERT_LE(value, 1.0 + 1e-6);
+  }
+}
+
+std::string robot_reach_avoid_yaml(double state_eta, double input_eta, unsigned horizon) {
+  return "name: robot_reach_avoid\n"
+         "states: {lb: [-10, -10], ub: [10, 10], eta: [" + std::to_string(state_eta) + ", " +
+         std::to_string(state_eta) + "]}\n"
+         "inputs: {lb: [-1, -1], ub: [1, 1], eta: [" + std::to_string(input_eta) + ", " +
+         std::to_string(input_eta) + "]}\n"
+         "constants: {tau: 10.0}\n"
+         "dynamics: [\"x0 + tau*u0*cos(u1)\", \"x1 + tau*u0*sin(u1)\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+         "spec: {type: reach_avoid, horizon: " + std::to_string(horizon) + ",\n"
+         "       target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
+}
+
+std::string robot_safety_yaml(double state_eta, double input_eta, unsigned horizon) {
+  return "name: robot_safety\n"
+         "states: {lb: [-10, -10], ub: [10, 10], eta: [" + std::to_string(state_eta) + ", " +
+         std::to_string(state_eta) + "]}\n"
+         "inputs: {lb: [-1, -1], ub: [1, 1], eta: [" + std::to_string(input_eta) + ", " +
+         std::to_string(input_eta) + "]}\n"
+         "disturbances: {lb: [-1], ub: [1], eta: [0.2]}\n"
+         "constants: {tau: 10.0}\n"
+         "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+         "spec: {type: safety, horizon: " + std::to_string(horizon) + "}\n";
+}
+
+TEST(OpenClEngine, ListsDevices) {
+  const auto devices = list_opencl_devices();
+  ASSERT_FALSE(devices.empty()) << "pocl (pocl-opencl-icd) must be installed";
+  for (const auto& line : devices) {
+    EXPECT_EQ(line.rfind("[", 0), 0u) << line;
+    EXPECT_NE(line.find(" / "), std::string::npos) << line;
+    EXPECT_NE(line.find("MiB"), std::string::npos) << line;
+  }
+}
+
+TEST(OpenClEngine, RobotReachAvoidReducedAgreesWithReference) {
+  expect_agreement("robot reach-avoid reduced", from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 8)));
+}
+
+TEST(OpenClEngine, RobotSafetyWithDisturbanceReducedAgreesWithReference) {
+  expect_agreement("robot safety reduced", from_yaml(robot_safety_yaml(1.0, 0.4, 6)));
+}
+
+TEST(OpenClEngine, RoomTemperature3dAgreesWithReference) {
+  // Paper section 7 (3-d variant): rooms 0 and 2 heated, conduction 0.2, beta 0.022,
+  // heater gamma 0.05, T_e = -1, T_h = 50; noise standard deviation 0.1 so windows span cells.
+  const std::string yaml =
+      "name: room_temperature_3d\n"
+      "states: {lb: [19, 19, 19], ub: [21, 21, 21], eta: [0.4, 0.4, 0.4]}\n"
+      "inputs: {lb: [0, 0], ub: [1, 1], eta: [0.2, 0.2]}\n"
+      "constants: {c: 0.2, beta: 0.022, gamma: 0.05, te: -1, th: 50}\n"
+      "dynamics: [\"(1 - 2*c - beta - gamma*u0)*x0 + gamma*th*u0 + c*(x1 + x2) + beta*te\",\n"
+      "           \"(1 - 2*c - beta)*x1 + c*(x0 + x2) + beta*te\",\n"
+      "           \"(1 - 2*c - beta - gamma*u1)*x2 + gamma*th*u1 + c*(x0 + x1) + beta*te\"]\n"
+      "noise: {type: additive, distribution: normal, covariance: [0.01, 0.01, 0.01],\n"
+      "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+      "spec: {type: safety, horizon: 8}\n";
+  expect_agreement("room temperature 3d", from_yaml(yaml));
+}
+
+TEST(OpenClEngine, RandomAffineSystemsWithDisturbancesAgreeWithReference) {
+  for (std::uint64_t seed : {11u, 12u}) {
+    const Abstraction safety = random_affine_abstraction(seed, 2, 1, true, safety_spec(5), 7);
+    expect_agreement("random affine safety seed " + std::to_string(seed), safety);
+    const Abstraction reach = random_affine_abstraction(
+        seed + 100, 3, 2, true, reach_avoid_spec(4, box({0.2, -1, -1}, {1, 1, 1}), box({-1, -1, -1}, {-0.6, 1, 1})), 5);
+    expect_agreement("random affine reach-avoid seed " + std::to_string(seed + 100), reach);
+  }
+}
+
+TEST(OpenClEngine, RandomNonlinearExpressionSystemsAgreeWithReference) {
+  std::mt19937_64 generator(7);
+  std::uniform_real_distribution<double> coefficient(-0.5, 0.5);
+  for (int trial = 0; trial < 3; ++trial) {
+    char dynamics[512];
+    std::snprintf(dynamics, sizeof dynamics,
+                  "[\"0.6*x0 + %.6f*sin(x1) + 0.5*u0 + %.6f*w0\", \"0.7*x1 + %.6f*x0*x0 + 0.4*u0*cos(x0) + 0.2*w0\"]",
+                  coefficient(generator), coefficient(generator), coefficient(generator));
+    const std::string yaml = std::string("name: random_nonlinear\n") +
+                             "states: {lb: [-2, -2], ub: [2, 2], eta: [0.25, 0.25]}\n"
+                             "inputs: {lb: [-1], ub: [1], eta: [0.25]}\n"
+                             "disturbances: {lb: [-0.3], ub: [0.3], eta: [0.3]}\n"
+                             "dynamics: " + dynamics + "\n"
+                             "noise: {type: additive, distribution: normal, covariance: [0.04, 0.09],\n"
+                             "        truncation: cutting_probability, cutting_probability: 1.0e-4}\n"
+                             "spec: {type: reach_avoid, horizon: 6, target: {lb: [-0.5, -0.5], ub: [0.5, 0.5]},\n"
+                             "       avoid: {lb: [1.5, -2], ub: [2, 2]}}\n";
+    expect_agreement("random nonlinear " + std::to_string(trial), from_yaml(yaml));
+  }
+}
+
+TEST(OpenClEngine, MultiplicativeAndUniformNoiseAgreeWithReference) {
+  const std::string grid =
+      "states: {lb: [-2, -2], ub: [2, 2], eta: [0.25, 0.25]}\n"
+      "inputs: {lb: [-1], ub: [1], eta: [0.5]}\n"
+      "dynamics: [\"0.8*x0 + 0.3*u0\", \"0.5*x1 + 0.2*x0*u0\"]\n"
+      "spec: {type: safety, horizon: 5, safe: {lb: [-1.5, -1.5], ub: [1.5, 1.5]}}\n";
+  expect_agreement("multiplicative normal",
+                   from_yaml("name: m\n" + grid +
+                             "noise: {type: multiplicative, distribution: normal, covariance: [0.04, 0.01],\n"
+                             "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"));
+  expect_agreement("additive uniform",
+                   from_yaml("name: u\n" + grid +
+                             "noise: {type: additive, distribution: uniform, half_width: [0.3, 0.2],\n"
+                             "        truncation: cutting_probability}\n"));
+  expect_agreement("fixed region, no truncation",
+                   from_yaml("name: f\n" + grid +
+                             "noise: {type: additive, distribution: normal, covariance: [0.04, 0.04],\n"
+                             "        truncation: fixed_region, fixed_region: [0.5, 0.25]}\n"));
+  // Window half width (20 cells) far beyond the grid (5 cells) and means far off the grid:
+  // the kept range is nearest +- h of the noise model, not of the capped layout.
+  expect_agreement("wide noise, small grid",
+                   from_yaml("name: w\n"
+                             "states: {lb: [-1], ub: [1], eta: [0.5]}\n"
+                             "inputs: {lb: [-1], ub: [1], eta: [0.25]}\n"
+                             "dynamics: [\"0.5*x0 + 9*u0\"]\n"
+                             "noise: {type: additive, distribution: normal, covariance: [9.0],\n"
+                             "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+                             "spec: {type: safety, horizon: 3}\n"));
+  expect_agreement("no truncation",
+                   from_yaml("name: n\n" + grid +
+                             "noise: {type: additive, distribution: normal, covariance: [0.04, 0.04],\n"
+                             "        truncation: none}\n"));
+}
+
+// Same kernels, four ways: stored/on-the-fly x work-item/work-group, plus a chunked run. The
+// per-(state, input) arithmetic is the same code, so the results must be bit-identical.
+TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
+  const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
+  SynthesisReport stored_report;
+  const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
+                                                  {SweepVariant::ItemPerState, 0});
+  EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
+  struct Variant {
+    const char* name;
+    TransitionStorage transitions;
+    OpenClEngineOptions engine;
+  };
+  const Variant variants[] = {
+      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50}},
+  };
+  for (const Variant& variant : variants) {
+    SynthesisReport report;
+    const Policy other = detail::synthesize_opencl(a, cpu_options(variant.transitions), &report, variant.engine);
+    EXPECT_EQ(other.values, stored.values) << variant.name;
+    EXPECT_EQ(other.input_index, stored.input_index) << variant.name;
+    const bool group = variant.engine.variant == SweepVariant::GroupPerState;
+    const bool logged = std::any_of(report.log.begin(), report.log.end(), [&](const std::string& line) {
+      return line.find(group ? "work-group" : "work-item") != std::string::npos;
+    });
+    EXPECT_TRUE(logged) << variant.name << ": the sweep variant that ran is logged";
+    if (variant.engine.max_states_per_chunk)
+      EXPECT_TRUE(std::any_of(report.log.begin(), report.log.end(),
+                              [](const std::string& line) { return line.find("chunks") != std::string::npos; }))
+          << variant.name;
+  }
+}
+
+TEST(OpenClEngine, AutoTransitionsFallsBackToOnTheFlyWhenStoredDoesNotFit) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
+  SynthesisOptions options = cpu_options(TransitionStorage::Auto);
+  options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
+  SynthesisReport report;
+  const Policy small_budget = synthesize(a, options, &report);
+  EXPECT_EQ(report.transitions.rfind("on_the_fly (auto", 0), 0u) << report.transitions;
+  SynthesisReport stored_report;
+  const Policy stored = synthesize(a, cpu_options(TransitionStorage::Auto), &stored_report);
+  EXPECT_EQ(stored_report.transitions.rfind("stored (auto", 0), 0u) << stored_report.transitions;
+  EXPECT_EQ(small_budget.values, stored.values);
+}
+
+TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 3));
+  std::vector<Progress> seen;
+  SynthesisOptions options = cpu_options(TransitionStorage::Stored);
+  options.profile = true;
+  options.progress = [&](const Progress& progress) {
+    seen.push_back(progress);
+    return true;
+  };
+  SynthesisReport report;
+  const Policy policy = synthesize(a, options, &report);
+  std::vector<std::string> names;
+  for (const auto& phase : report.phases) names.push_back(phase.name);
+  const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0"};
+  EXPECT_EQ(names, expected);
+  EXPECT_GT(report.phases[2].pairs_per_second, 0);
+  EXPECT_GT(report.phases[3].multiply_adds, 0);
+  EXPECT_GT(report.device_bytes, a.pairs() * sizeof(float));
+  EXPECT_FALSE(report.device.empty());
+  EXPECT_EQ(policy.computed_by, report.device);
+  ASSERT_EQ(seen.size(), 5u);  // setup, construction, 3 steps
+  EXPECT_EQ(seen.front().phase, "setup");
+  EXPECT_EQ(seen[1].phase, "construction");
+  EXPECT_EQ(seen.back().steps_done, 3u);
+  EXPECT_DOUBLE_EQ(seen.back().percent(), 100.0);
+}
+
+TEST(OpenClEngine, CancelThrowsCancelled) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 5));
+  SynthesisOptions options = cpu_options();
+  unsigned calls = 0;
+  options.progress = [&](const Progress& progress) {
+    ++calls;
+    return progress.steps_done < 2;
+  };
+  EXPECT_THROW(synthesize(a, options), Cancelled);
+  EXPECT_EQ(calls, 4u);  // setup, construction, step 1 done, step 2 done -> cancelled
+}
+
+TEST(OpenClEngine, FullCovarianceIsRefusedClearly) {
+  const Abstraction a = from_yaml(
+      "name: full\n"
+      "states: {lb: [-1, -1], ub: [1, 1], eta: [0.5, 0.5]}\n"
+      "dynamics: [\"0.5*x0\", \"0.5*x1\"]\n"
+      "noise: {type: additive, distribution: normal, covariance: [0.04, 0.01, 0.01, 0.04],\n"
+      "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+      "spec: {type: safety, horizon: 2}\n");
+  try {
+    synthesize(a, cpu_options());
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(error.key(), "noise.covariance");
+    EXPECT_NE(std::string(error.what()).find("reference"), std::string::npos) << error.what();
+  }
+}
+
+TEST(OpenClEngine, GpuRequestWithoutGpuFallsBackWithWarning) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
+  const bool has_gpu = [] {
+    for (const auto& line : list_opencl_devices())
+      if (line.find("(GPU") != std::string::npos) return true;
+    return false;
+  }();
+  if (has_gpu) GTEST_SKIP() << "a GPU is present; the fallback cannot be observed";
+  SynthesisOptions options = cpu_options();
+  options.compute.device = DeviceKind::Gpu;
+  SynthesisReport report;
+  synthesize(a, options, &report);
+  EXPECT_TRUE(std::any_of(report.log.begin(), report.log.end(), [](const std::string& line) {
+    return line.find("warning") != std::string::npos && line.find("no OpenCL GPU") != std::string::npos;
+  }));
+}
+
+TEST(OpenClEngine, UnknownDeviceSelectionIsADeviceError) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
+  SynthesisOptions options = cpu_options();
+  options.compute.platform = "no-such-platform-name";
+  EXPECT_THROW(synthesize(a, options), DeviceError);
+}
+
+TEST(OpenClEngine, RobotReachAvoidFullGridAgreesWithReference) {
+  // SPEC section 5's grid: 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
+  // 16 only to keep the serial reference under ~10 s here; the T_d = 16 comparison is recorded in
+  // docs/engine.md (max |dV| 2.2e-7).
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(0.5, 0.1, 6));
+  ASSERT_EQ(a.pairs(), 741321u);
+  expect_agreement("robot reach-avoid full", a);
+}
+
+}  // namespace
+}  // namespace amytiss
