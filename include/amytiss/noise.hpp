@@ -60,6 +60,10 @@ class NoiseModel {
   double interval_mass(std::size_t dim, double lo, double hi, double mean, double scale) const;
   /// Mass of the cell of grid index k along dim.
   double cell_mass(std::size_t dim, std::size_t k, double mean, double scale) const;
+  /// cell_mass(dim, k, mean, scale) for k = first..last into out[k - first], bit-identical to it;
+  /// each shared cell face's tail is computed once (one erfc per face instead of two per cell).
+  void cell_masses(std::size_t dim, std::int64_t first, std::int64_t last, double mean, double scale,
+                   double* out) const;
 
   /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
   /// bound documented in noise.cpp and README ("Full covariance"); |error| <= box_mass_tolerance().
@@ -94,7 +98,7 @@ class NoiseModel {
   std::vector<double> lb_, eta_;        // the state grid's (cell bounds lb + (k -+ 1/2)*eta)
   std::vector<std::size_t> counts_;     // the state grid's points per dimension
   std::vector<std::int64_t> window_half_cells_;
-  bool whole_grid_window_ = false;      // truncation none: every window is the whole grid
+  std::vector<char> whole_grid_dims_;  // truncation none (and some noise): the whole dimension
   // Full covariance quadrature (see noise.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
   // panel width per conditioning level in standard-normal units.
   std::vector<double> legendre_nodes_, legendre_weights_;

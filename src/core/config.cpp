@@ -11,6 +11,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/expression.hpp"
+#include "amytiss/noise.hpp"
 #include "amytiss/model.hpp"
 
 namespace amytiss {
@@ -200,6 +201,34 @@ double check_grid(const GridSpec& grid, const std::string& key, const std::strin
   return points;
 }
 
+// Grid indices first..last of dimension i that a (validated) box contains, by the membership rule
+// of Grid::point_in_box (closed box, 1e-9*eta tolerance).
+std::pair<double, double> box_index_range(const Box& box, const GridSpec& states, std::size_t i) {
+  const double eta = states.eta[i];
+  const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
+  const double first = std::max(0.0, std::ceil((box.lb[i] - states.lb[i]) / eta - 1e-9));
+  const double last = std::min(count - 1, std::floor((box.ub[i] - states.lb[i]) / eta + 1e-9));
+  return {first, last};
+}
+
+// A cell in both boxes would silently become avoid (avoid wins in the roles): refuse it.
+void check_target_avoid_disjoint(const Box& target, const Box& avoid, const GridSpec& states) {
+  std::vector<double> shared;
+  for (std::size_t i = 0; i < states.lb.size(); ++i) {
+    const auto target_range = box_index_range(target, states, i);
+    const auto avoid_range = box_index_range(avoid, states, i);
+    const double first = std::max(target_range.first, avoid_range.first);
+    const double last = std::min(target_range.second, avoid_range.second);
+    if (first > last) return;
+    shared.push_back(states.lb[i] + first * states.eta[i]);
+  }
+  throw ConfigError("spec.avoid", "the avoid box " + format_list(avoid.lb) + " .. " + format_list(avoid.ub) +
+                                      " and the target box " + format_list(target.lb) + " .. " +
+                                      format_list(target.ub) + " share grid points, for example " +
+                                      format_list(shared) +
+                                      "; expected boxes without a common grid point (shrink one of them)");
+}
+
 void check_box(const Box& box, const std::string& key, const GridSpec& states) {
   const std::string name = key.substr(key.rfind('.') + 1);
   const std::string example = name + ": {lb: [5, 5], ub: [7, 7]}";
@@ -217,8 +246,7 @@ void check_box(const Box& box, const std::string& key, const GridSpec& states) {
     // Same membership rule as Grid::point_in_box: closed box with a 1e-9*eta tolerance.
     const double eta = states.eta[i];
     const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
-    const double first = std::max(0.0, std::ceil((box.lb[i] - states.lb[i]) / eta - 1e-9));
-    const double last = std::min(count - 1, std::floor((box.ub[i] - states.lb[i]) / eta + 1e-9));
+    const auto [first, last] = box_index_range(box, states, i);
     if (first > last)
       throw ConfigError(key, "the box " + format_list(box.lb) + " .. " + format_list(box.ub) +
                                  " contains no representative point of the state grid in dimension " +
@@ -259,11 +287,23 @@ void check_noise(const NoiseConfig& noise, std::size_t n) {
     check_finite_list(c, "noise.covariance", example);
     if (c.size() == n) {
       for (std::size_t i = 0; i < n; ++i)
-        if (c[i] <= 0) fail(indexed("noise.covariance", i), format_number(c[i]), "a variance > 0", example);
+        if (c[i] < 0)
+          fail(indexed("noise.covariance", i), format_number(c[i]),
+               "a variance >= 0 (0: no noise in that dimension)", example);
     } else {
       if (noise.type == NoiseType::Multiplicative)
         throw ConfigError("noise.covariance",
                           "a full covariance matrix with multiplicative noise is not supported; give the " + n_text +
+                              " diagonal variances (example: " + example + ")");
+      bool diagonal = true;
+      for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t k = 0; k < n; ++k)
+          if (r != k && c[r * n + k] != 0.0) diagonal = false;
+      if (!diagonal && n > NoiseModel::kMaxFullCovarianceDims)
+        throw ConfigError("noise.covariance",
+                          "a full (non-diagonal) covariance is supported up to " +
+                              std::to_string(NoiseModel::kMaxFullCovarianceDims) + " state dimensions, got " + n_text +
+                              " (the quadrature cost grows like points^(n-1)); give the " + n_text +
                               " diagonal variances (example: " + example + ")");
       Eigen::MatrixXd matrix(n, n);
       for (std::size_t r = 0; r < n; ++r)
@@ -396,6 +436,7 @@ void Config::validate() const {
         if (spec.type == SpecType::Reachability)
           throw ConfigError("spec.avoid", "given for spec.type reachability; use reach_avoid to avoid a set");
         check_box(*spec.avoid, "spec.avoid", states);
+        check_target_avoid_disjoint(*spec.target, *spec.avoid, states);
       }
       break;
   }

@@ -11,13 +11,20 @@ namespace amytiss {
 
 enum class NodeKind { Number, Variable, Unary, Binary, Call, Conditional };
 enum class VariableSpace { State, Input, Disturbance };
+// Resolved when the node is built so that evaluation switches on an integer, never on text.
+enum class Operation {
+  None, Negate, Not, Add, Subtract, Multiply, Divide, Power, Less, LessEqual, Greater, GreaterEqual,
+  Equal, NotEqual, And, Or, Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Exp, Log, Sqrt, Pow, Abs, Min,
+  Max, Floor, Ceil
+};
 
 struct ExpressionNode {
   NodeKind kind = NodeKind::Number;
   double number = 0.0;
   VariableSpace space = VariableSpace::State;
   std::size_t index = 0;
-  std::string op;  // operator symbol (unary/binary) or function name (call)
+  std::string op;  // operator symbol (unary/binary) or function name (call), for to_c()
+  Operation operation = Operation::None;
   std::vector<std::shared_ptr<const ExpressionNode>> children;
 };
 
@@ -29,15 +36,35 @@ struct FunctionInfo {
   const char* name;
   std::size_t arity;
   const char* c_name;
+  Operation operation;
 };
 
 const FunctionInfo kFunctions[] = {
-    {"sin", 1, "sin"},     {"cos", 1, "cos"},     {"tan", 1, "tan"},     {"asin", 1, "asin"},
-    {"acos", 1, "acos"},   {"atan", 1, "atan"},   {"atan2", 2, "atan2"}, {"exp", 1, "exp"},
-    {"log", 1, "log"},     {"sqrt", 1, "sqrt"},   {"pow", 2, "pow"},     {"abs", 1, "fabs"},
-    {"min", 2, "fmin"},    {"max", 2, "fmax"},    {"floor", 1, "floor"}, {"ceil", 1, "ceil"},
-    {"if", 3, nullptr},
+    {"sin", 1, "sin", Operation::Sin},       {"cos", 1, "cos", Operation::Cos},
+    {"tan", 1, "tan", Operation::Tan},       {"asin", 1, "asin", Operation::Asin},
+    {"acos", 1, "acos", Operation::Acos},    {"atan", 1, "atan", Operation::Atan},
+    {"atan2", 2, "atan2", Operation::Atan2}, {"exp", 1, "exp", Operation::Exp},
+    {"log", 1, "log", Operation::Log},       {"sqrt", 1, "sqrt", Operation::Sqrt},
+    {"pow", 2, "pow", Operation::Pow},       {"abs", 1, "fabs", Operation::Abs},
+    {"min", 2, "fmin", Operation::Min},      {"max", 2, "fmax", Operation::Max},
+    {"floor", 1, "floor", Operation::Floor}, {"ceil", 1, "ceil", Operation::Ceil},
+    {"if", 3, nullptr, Operation::None},
 };
+
+Operation operator_operation(NodeKind kind, const std::string& op) {
+  if (kind == NodeKind::Unary) return op == "-" ? Operation::Negate : Operation::Not;
+  static const struct {
+    const char* symbol;
+    Operation operation;
+  } kBinary[] = {{"+", Operation::Add},        {"-", Operation::Subtract}, {"*", Operation::Multiply},
+                 {"/", Operation::Divide},     {"^", Operation::Power},    {"<", Operation::Less},
+                 {"<=", Operation::LessEqual}, {">", Operation::Greater},  {">=", Operation::GreaterEqual},
+                 {"==", Operation::Equal},     {"!=", Operation::NotEqual}, {"&&", Operation::And},
+                 {"||", Operation::Or}};
+  for (const auto& entry : kBinary)
+    if (op == entry.symbol) return entry.operation;
+  return Operation::None;
+}
 
 const FunctionInfo* find_function(const std::string& name) {
   for (const auto& info : kFunctions)
@@ -154,6 +181,8 @@ NodePtr make_operator(NodeKind kind, const std::string& op, std::vector<NodePtr>
   node->kind = kind;
   node->op = op;
   node->children = std::move(children);
+  if (kind == NodeKind::Unary || kind == NodeKind::Binary) node->operation = operator_operation(kind, op);
+  if (kind == NodeKind::Call) node->operation = find_function(op)->operation;
   return node;
 }
 
@@ -386,51 +415,58 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
       return 0.0;
     case NodeKind::Unary: {
       const double operand = evaluate_node(*node.children[0], x, u, w);
-      return node.op == "-" ? -operand : (operand == 0.0 ? 1.0 : 0.0);
+      return node.operation == Operation::Negate ? -operand : (operand == 0.0 ? 1.0 : 0.0);
     }
     case NodeKind::Conditional:
       return evaluate_node(*node.children[0], x, u, w) != 0.0 ? evaluate_node(*node.children[1], x, u, w)
                                                                : evaluate_node(*node.children[2], x, u, w);
     case NodeKind::Binary: {
-      const std::string& op = node.op;
       const double left = evaluate_node(*node.children[0], x, u, w);
-      if (op == "&&") return (left != 0.0 && evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
-      if (op == "||") return (left != 0.0 || evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
+      if (node.operation == Operation::And)
+        return (left != 0.0 && evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
+      if (node.operation == Operation::Or)
+        return (left != 0.0 || evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
       const double right = evaluate_node(*node.children[1], x, u, w);
-      if (op == "+") return left + right;
-      if (op == "-") return left - right;
-      if (op == "*") return left * right;
-      if (op == "/") return left / right;
-      if (op == "^") return std::pow(left, right);
-      if (op == "<") return left < right ? 1.0 : 0.0;
-      if (op == "<=") return left <= right ? 1.0 : 0.0;
-      if (op == ">") return left > right ? 1.0 : 0.0;
-      if (op == ">=") return left >= right ? 1.0 : 0.0;
-      if (op == "==") return left == right ? 1.0 : 0.0;
-      if (op == "!=") return left != right ? 1.0 : 0.0;
-      return 0.0;
+      switch (node.operation) {
+        case Operation::Add: return left + right;
+        case Operation::Subtract: return left - right;
+        case Operation::Multiply: return left * right;
+        case Operation::Divide: return left / right;
+        case Operation::Power: return std::pow(left, right);
+        case Operation::Less: return left < right ? 1.0 : 0.0;
+        case Operation::LessEqual: return left <= right ? 1.0 : 0.0;
+        case Operation::Greater: return left > right ? 1.0 : 0.0;
+        case Operation::GreaterEqual: return left >= right ? 1.0 : 0.0;
+        case Operation::Equal: return left == right ? 1.0 : 0.0;
+        case Operation::NotEqual: return left != right ? 1.0 : 0.0;
+        default: return 0.0;
+      }
     }
     case NodeKind::Call: {
-      const std::string& f = node.op;
       const double a = evaluate_node(*node.children[0], x, u, w);
-      if (f == "sin") return std::sin(a);
-      if (f == "cos") return std::cos(a);
-      if (f == "tan") return std::tan(a);
-      if (f == "asin") return std::asin(a);
-      if (f == "acos") return std::acos(a);
-      if (f == "atan") return std::atan(a);
-      if (f == "exp") return std::exp(a);
-      if (f == "log") return std::log(a);
-      if (f == "sqrt") return std::sqrt(a);
-      if (f == "abs") return std::fabs(a);
-      if (f == "floor") return std::floor(a);
-      if (f == "ceil") return std::ceil(a);
+      switch (node.operation) {
+        case Operation::Sin: return std::sin(a);
+        case Operation::Cos: return std::cos(a);
+        case Operation::Tan: return std::tan(a);
+        case Operation::Asin: return std::asin(a);
+        case Operation::Acos: return std::acos(a);
+        case Operation::Atan: return std::atan(a);
+        case Operation::Exp: return std::exp(a);
+        case Operation::Log: return std::log(a);
+        case Operation::Sqrt: return std::sqrt(a);
+        case Operation::Abs: return std::fabs(a);
+        case Operation::Floor: return std::floor(a);
+        case Operation::Ceil: return std::ceil(a);
+        default: break;
+      }
       const double b = evaluate_node(*node.children[1], x, u, w);
-      if (f == "atan2") return std::atan2(a, b);
-      if (f == "pow") return std::pow(a, b);
-      if (f == "min") return std::fmin(a, b);
-      if (f == "max") return std::fmax(a, b);
-      return 0.0;
+      switch (node.operation) {
+        case Operation::Atan2: return std::atan2(a, b);
+        case Operation::Pow: return std::pow(a, b);
+        case Operation::Min: return std::fmin(a, b);
+        case Operation::Max: return std::fmax(a, b);
+        default: return 0.0;
+      }
     }
   }
   return 0.0;

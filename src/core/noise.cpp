@@ -130,8 +130,16 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
       if (!std::isfinite(cov[i]))
         throw ConfigError("noise.covariance", "value " + std::to_string(i) + " is not finite");
     covariance_.assign(n * n, 0.0);
-    if (cov.size() == n && n * n != n) {
-      for (std::size_t i = 0; i < n; ++i) covariance_[i * n + i] = cov[i];
+    // The diagonal form (n values) may give a variance of exactly 0: that dimension has no noise
+    // (a point mass). A full matrix must be positive definite for the conditioning quadrature.
+    const bool diagonal_form = cov.size() == n;
+    if (diagonal_form) {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!(cov[i] >= 0))
+          throw ConfigError("noise.covariance", "variance " + std::to_string(i) + " is " + number(cov[i]) +
+                                                    ", expected a number >= 0 (0: no noise in that dimension)");
+        covariance_[i * n + i] = cov[i];
+      }
     } else {
       covariance_ = cov;
     }
@@ -147,18 +155,24 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
       }
     // Cholesky; a non-positive pivot means the matrix is not positive definite.
     cholesky_.assign(n * n, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t j = 0; j <= i; ++j) {
-        double sum = covariance_[i * n + j];
-        for (std::size_t k = 0; k < j; ++k) sum -= cholesky_[i * n + k] * cholesky_[j * n + k];
-        if (i == j) {
-          if (!(sum > 0))
-            throw ConfigError("noise.covariance",
-                              "the matrix is not positive definite (pivot " + std::to_string(i) +
-                                  " is " + number(sum) + "); expected positive variances (example: covariance: [0.75, 0.75])");
-          cholesky_[i * n + i] = std::sqrt(sum);
-        } else {
-          cholesky_[i * n + j] = sum / cholesky_[j * n + j];
+    if (diagonal_form) {
+      for (std::size_t i = 0; i < n; ++i) cholesky_[i * n + i] = std::sqrt(covariance_[i * n + i]);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j <= i; ++j) {
+          double sum = covariance_[i * n + j];
+          for (std::size_t k = 0; k < j; ++k) sum -= cholesky_[i * n + k] * cholesky_[j * n + k];
+          if (i == j) {
+            if (!(sum > 0))
+              throw ConfigError("noise.covariance",
+                                "the matrix is not positive definite (pivot " + std::to_string(i) + " is " +
+                                    number(sum) +
+                                    "); expected positive variances (example: covariance: [0.75, 0.75]; a "
+                                    "dimension without noise needs the diagonal form with variance 0)");
+            cholesky_[i * n + i] = std::sqrt(sum);
+          } else {
+            cholesky_[i * n + j] = sum / cholesky_[j * n + j];
+          }
         }
       }
     }
@@ -203,14 +217,17 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
   }
 
   window_half_cells_.assign(n, 0);
+  whole_grid_dims_.assign(n, 0);
   cut_mass_bound_ = 0.0;
   auto set_half = [&](std::size_t i, double half_cells) {
     window_half_cells_[i] = static_cast<std::int64_t>(std::min(half_cells, kMaxHalfCells));
   };
   switch (config.truncation) {
     case Truncation::None:
-      whole_grid_window_ = true;
-      for (std::size_t i = 0; i < n; ++i) window_half_cells_[i] = std::int64_t(counts_[i]) - 1;
+      for (std::size_t i = 0; i < n; ++i) {
+        window_half_cells_[i] = std::int64_t(counts_[i]) - 1;
+        whole_grid_dims_[i] = 1;
+      }
       break;
     case Truncation::FixedRegion: {
       if (config.fixed_region.size() != n)
@@ -257,6 +274,14 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
         cut_mass_bound_ = 0.0;
       }
       break;
+    }
+  }
+  // A dimension without noise anywhere on the grid puts all its mass in one cell (the one
+  // containing the post state): its window is that cell, whatever the truncation mode.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (largest_scale[i] == 0.0) {
+      window_half_cells_[i] = 0;
+      whole_grid_dims_[i] = 0;
     }
   }
 
@@ -333,6 +358,35 @@ double NoiseModel::cell_mass(std::size_t dim, std::size_t k, double mean, double
   return interval_mass(dim, lo, hi, mean, scale);
 }
 
+void NoiseModel::cell_masses(std::size_t dim, std::int64_t first, std::int64_t last, double mean, double scale,
+                             double* out) const {
+  if (distribution_ != Distribution::Normal || scale == 0.0 || last < first) {
+    for (std::int64_t k = first; k <= last; ++k) out[k - first] = cell_mass(dim, std::size_t(k), mean, scale);
+    return;
+  }
+  // Each face is shared by two cells (lb + (k + 1/2)*eta == lb + ((k+1) - 1/2)*eta exactly for
+  // integer k), so its standardized position z and tail Q(|z|) are computed once. Every cell then
+  // takes exactly the branch and the operands of standard_normal_interval: bit-identical masses.
+  thread_local std::vector<double> z, tail;
+  const std::size_t faces = std::size_t(last - first) + 2;
+  z.resize(faces);
+  tail.resize(faces);
+  for (std::size_t f = 0; f < faces; ++f) {
+    const double face = lb_[dim] + (double(first + std::int64_t(f)) - 0.5) * eta_[dim];
+    z[f] = (face - mean) / scale;
+    tail[f] = upper_tail(z[f] >= 0 ? z[f] : -z[f]);
+  }
+  for (std::size_t c = 0; c + 1 < faces; ++c) {
+    const double a = z[c], b = z[c + 1];
+    double mass;
+    if (!(a < b)) mass = 0.0;
+    else if (a >= 0) mass = tail[c] - tail[c + 1];
+    else if (b <= 0) mass = tail[c + 1] - tail[c];
+    else mass = 1.0 - tail[c + 1] - tail[c];
+    out[c] = mass;
+  }
+}
+
 double NoiseModel::box_mass(const double* lo, const double* hi, const double* mean) const {
   if (separable_) {
     double mass = 1.0;
@@ -397,7 +451,7 @@ double NoiseModel::box_mass_with(const double* lo, const double* hi, const doubl
 bool NoiseModel::window(const Grid& states, const double* mean, std::int64_t* first, std::int64_t* last) const {
   for (std::size_t i = 0; i < dims_; ++i) {
     const auto count = static_cast<std::int64_t>(counts_[i]);
-    if (whole_grid_window_) {
+    if (whole_grid_dims_[i]) {
       first[i] = 0;
       last[i] = count - 1;
       continue;

@@ -274,7 +274,10 @@ constexpr long long kUnrollLimit = 64;
 std::string contraction_source(const Layout& layout) {
   const std::size_t dims = layout.width.size();
   std::ostringstream s;
-  s << "float contract(__global const float* v, const float* m) {\n  float acc0 = 0.0f;\n";
+  // Masses and values are stored in float; products and sums are formed in double (exact
+  // products of two floats, sums with 2^-53 rounding), rounded to float once on return: the
+  // worst-case error no longer grows with the window length (docs/engine.md, Precision).
+  s << "float contract(__global const float* v, const float* m) {\n  double acc0 = 0.0;\n";
   std::string pointer = "v";
   std::size_t closing = 0;  // loops opened
   for (std::size_t i = 0; i < dims; ++i) {
@@ -290,29 +293,30 @@ std::string contraction_source(const Layout& layout) {
       for (long long lanes : {8LL, 4LL, 2LL}) {
         while (layout.width[i] - j >= lanes) {
           const std::string n = std::to_string(lanes);
-          terms.push_back("vload" + n + "(0, m + " + std::to_string(layout.mass_offset[i] + j) + ") * vload" + n +
-                          "(0, " + pointer + " + " + std::to_string(j) + ")");
+          terms.push_back("convert_double" + n + "(vload" + n + "(0, m + " + std::to_string(layout.mass_offset[i] + j) +
+                          ")) * convert_double" + n + "(vload" + n + "(0, " + pointer + " + " + std::to_string(j) + "))");
           j += lanes;
         }
       }
       if (j < layout.width[i])
-        terms.push_back("m[" + std::to_string(layout.mass_offset[i] + j) + "] * " + pointer + "[" + std::to_string(j) + "]");
+        terms.push_back("(double)m[" + std::to_string(layout.mass_offset[i] + j) + "] * (double)" + pointer + "[" +
+                        std::to_string(j) + "]");
       // Reduce each vector term to a scalar by halving (s.lo + s.hi), then sum the scalars.
       std::vector<std::string> scalars;
       for (std::size_t t = 0; t < terms.size(); ++t) {
         const std::string name = "row" + std::to_string(t);
-        const bool vector = terms[t].rfind("vload", 0) == 0;
-        const std::string width = vector ? terms[t].substr(5, 1) : "1";
+        const bool vector = terms[t].rfind("convert_double", 0) == 0;
+        const std::string width = vector ? terms[t].substr(14, 1) : "1";
         if (!vector) {
           scalars.push_back("(" + terms[t] + ")");
           continue;
         }
-        s << indent << "float" << width << " " << name << " = " << terms[t] << ";\n";
+        s << indent << "double" << width << " " << name << " = " << terms[t] << ";\n";
         std::string current = name;
         int lanes = std::stoi(width);
         while (lanes > 1) {
           const std::string next = name + "_" + std::to_string(lanes / 2);
-          s << indent << (lanes / 2 > 1 ? "float" + std::to_string(lanes / 2) : std::string("float")) << " " << next
+          s << indent << (lanes / 2 > 1 ? "double" + std::to_string(lanes / 2) : std::string("double")) << " " << next
             << " = " << current << ".lo + " << current << ".hi;\n";
           current = next;
           lanes /= 2;
@@ -333,16 +337,16 @@ std::string contraction_source(const Layout& layout) {
     ++closing;
     const std::string mass = "m[" + std::to_string(layout.mass_offset[i]) + " + " + a + "]";
     if (innermost) {
-      s << indent << "  " << acc << " = fma(" << mass << ", " << pointer << "[" << a << " * "
+      s << indent << "  " << acc << " = fma((double)" << mass << ", (double)" << pointer << "[" << a << " * "
         << layout.padded_stride[i] << "], " << acc << ");\n";
     } else {
       const std::string next_pointer = "v" + std::to_string(i);
-      s << indent << "  const float mass" << i << " = " << mass << ";\n";
+      s << indent << "  const double mass" << i << " = " << mass << ";\n";
       // Rows outside the grid or the truncation region carry zero mass: skip them.
-      s << indent << "  if (mass" << i << " == 0.0f) continue;\n";
+      s << indent << "  if (mass" << i << " == 0.0) continue;\n";
       s << indent << "  __global const float* " << next_pointer << " = " << pointer << " + " << a
         << " * " << layout.padded_stride[i] << ";\n";
-      s << indent << "  float acc" << i + 1 << " = 0.0f;\n";
+      s << indent << "  double acc" << i + 1 << " = 0.0;\n";
       pointer = next_pointer;
     }
   }
@@ -352,7 +356,7 @@ std::string contraction_source(const Layout& layout) {
       s << indent << "  acc" << i << " = fma(mass" << i << ", acc" << i + 1 << ", acc" << i << ");\n";
     s << indent << "}\n";
   }
-  s << "  return acc0;\n}\n";
+  s << "  return (float)acc0;\n}\n";
   return s.str();
 }
 

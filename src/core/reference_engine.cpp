@@ -129,10 +129,8 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
           if (noise.window(states, mean.data(), first.data(), last.data())) {
             if (noise.separable()) {
               for (std::size_t d = 0; d < dims; ++d) {
-                masses[d].clear();
-                const double scale = noise.scale(d, x.data());
-                for (std::int64_t k = first[d]; k <= last[d]; ++k)
-                  masses[d].push_back(noise.cell_mass(d, std::size_t(k), mean[d], scale));
+                masses[d].resize(std::size_t(last[d] - first[d] + 1));
+                noise.cell_masses(d, first[d], last[d], mean[d], noise.scale(d, x.data()), masses[d].data());
               }
               window_sum.multiply_adds = 0;
               expected = window_sum.sum(0, 0, 1.0);

@@ -218,7 +218,32 @@ TEST(Config, NoiseErrors) {
 
   root = base();
   root["noise"]["covariance"] = YAML::Load("[0.75, -0.1]");
-  expect_error(root, "noise.covariance[1]", "expected a variance > 0");
+  expect_error(root, "noise.covariance[1]", "expected a variance >= 0 (0: no noise in that dimension)");
+
+  // A diagonal variance of exactly 0 is a dimension without noise; a full matrix stays SPD.
+  root = base();
+  root["noise"]["covariance"] = YAML::Load("[0.75, 0]");
+  EXPECT_NO_THROW(config_from_yaml(root));
+  root = base();
+  root["noise"]["covariance"] = YAML::Load("[0.75, 0, 0, 0]");
+  expect_error(root, "noise.covariance", "not positive definite");
+
+  // Full covariance beyond NoiseModel::kMaxFullCovarianceDims (4) dimensions; a full matrix with
+  // zero off-diagonal entries is diagonal and stays allowed.
+  {
+    const char* const five_dims = R"(
+name: five
+states: {lb: [0, 0, 0, 0, 0], ub: [1, 1, 1, 1, 1], eta: [0.5, 0.5, 0.5, 0.5, 0.5]}
+dynamics: ["x0", "x1", "x2", "x3", "x4"]
+noise: {covariance: [1, 0.1, 0, 0, 0,  0.1, 1, 0, 0, 0,  0, 0, 1, 0, 0,  0, 0, 0, 1, 0,  0, 0, 0, 0, 1]}
+spec: {type: safety, horizon: 2}
+)";
+    root = YAML::Load(five_dims);
+    expect_error(root, "noise.covariance", "supported up to 4 state dimensions, got 5");
+    root = YAML::Load(five_dims);
+    root["noise"]["covariance"] = YAML::Load("[1, 0, 0, 0, 0,  0, 1, 0, 0, 0,  0, 0, 1, 0, 0,  0, 0, 0, 1, 0,  0, 0, 0, 0, 1]");
+    EXPECT_NO_THROW(config_from_yaml(root));
+  }
 
   root = base();
   root["noise"]["covariance"] = YAML::Load("[1, 0.5, 0.4, 1]");
@@ -328,6 +353,16 @@ TEST(Config, SpecErrors) {
   root = base();
   root["spec"]["safe"] = YAML::Load("{lb: [-30, -30], ub: [-20, -20]}");
   expect_error(root, "spec.safe", "contains no representative point");
+  // Target and avoid sharing grid points (eta 0.5): target x0 5..7, avoid x0 6.6..8 share 7;
+  // x1 5..7 and 4..5.2 share 5. Boxes that overlap only between grid points are fine.
+  root = base();
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [6.6, 4], ub: [8, 5.2]}}");
+  expect_error(root, "spec.avoid", "share grid points, for example [7, 5]");
+  root = base();
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [7.1, 4], ub: [8, 5.2]}}");
+  EXPECT_NO_THROW(config_from_yaml(root));
   // A box that touches exactly one grid point is fine.
   root = base();
   root["spec"] = YAML::Load("{type: reachability, horizon: 4, target: {lb: [5, 5], ub: [5, 5]}}");

@@ -259,7 +259,7 @@ TEST(NoiseConfigErrors, RejectsBadCovariance) {
   EXPECT_THROW(NoiseModel(normal_noise({1.0, 0.5, 0.4, 1.0}), grid), ConfigError);       // not symmetric
   EXPECT_THROW(NoiseModel(normal_noise({1.0, 2.0, 2.0, 1.0}), grid), ConfigError);       // not positive definite
   EXPECT_THROW(NoiseModel(normal_noise({1.0, -1.0}), grid), ConfigError);                // negative variance
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 0.0}), grid), ConfigError);                 // zero variance
+  EXPECT_THROW(NoiseModel(normal_noise({1.0, 0.0, 0.0, 0.0}), grid), ConfigError);       // full: not SPD
   EXPECT_THROW(NoiseModel(normal_noise({1.0, 1.0}, Truncation::CuttingProbability, 1.5), grid), ConfigError);
   EXPECT_THROW(NoiseModel(normal_noise({1.0, 1.0}, Truncation::FixedRegion, 1e-3, {1.0}), grid), ConfigError);
   EXPECT_THROW(NoiseModel(uniform_noise({1.0}), grid), ConfigError);
@@ -365,6 +365,76 @@ TEST(FullCovariance, ThreeDimensionsAgreeUnderReorderedConditioning) {
                 noise.box_mass_tolerance() + noise_reversed.box_mass_tolerance());
   }
   EXPECT_LT(noise.box_mass_tolerance(), 1e-8);
+}
+
+TEST(NormalNoise, CellMassesAreBitIdenticalToCellMass) {
+  const Grid grid(grid_spec({-3}, {3}, {0.1}));
+  std::mt19937_64 generator(7);
+  std::uniform_real_distribution<double> mean_draw(-4.0, 4.0), log_scale_draw(-4.0, 1.0);
+  std::vector<double> masses(grid.count(0));
+  for (const NoiseConfig& config : {normal_noise({1.0}), uniform_noise({0.35})}) {
+    const NoiseModel noise(config, grid);
+    for (int sample = 0; sample < 200; ++sample) {
+      const double mean = mean_draw(generator);
+      // Every tenth sample has scale 0 (a point mass); the others span tails and narrow peaks.
+      const double scale = sample % 10 == 0 ? 0.0 : std::pow(10.0, log_scale_draw(generator));
+      const std::int64_t first = sample % 7, last = std::int64_t(grid.count(0)) - 1 - sample % 5;
+      noise.cell_masses(0, first, last, mean, scale, masses.data());
+      for (std::int64_t k = first; k <= last; ++k)
+        ASSERT_EQ(masses[std::size_t(k - first)], noise.cell_mass(0, std::size_t(k), mean, scale))
+            << "k " << k << " mean " << mean << " scale " << scale;
+    }
+  }
+}
+
+TEST(ZeroVariance, DiagonalZeroIsAPointMassWithAOneCellWindow) {
+  const Grid grid(grid_spec({0, 0}, {4, 4}, {1, 1}));
+  for (Truncation truncation : {Truncation::None, Truncation::CuttingProbability, Truncation::FixedRegion}) {
+    const std::vector<double> region = truncation == Truncation::FixedRegion ? std::vector<double>{2.0, 2.0}
+                                                                             : std::vector<double>{};
+    const NoiseModel noise(normal_noise({0.25, 0.0}, truncation, 1e-3, region), grid);
+    EXPECT_TRUE(noise.separable());
+    EXPECT_EQ(noise.base_scale()[1], 0.0);
+    EXPECT_EQ(noise.window_half_cells()[1], 0) << "truncation " << int(truncation);
+    EXPECT_GT(noise.window_half_cells()[0], 0);
+    // Post mean (2.2, 2.4): dimension 1 puts everything in the cell [1.5, 2.5) of point 2.
+    const double mean[2] = {2.2, 2.4}, x[2] = {2.0, 2.0};
+    std::int64_t first[2], last[2];
+    ASSERT_TRUE(noise.window(grid, mean, first, last));
+    EXPECT_EQ(first[1], 2);
+    EXPECT_EQ(last[1], 2);
+    double row = 0.0;
+    for (std::size_t target = 0; target < grid.size(); ++target) {
+      const double probability = noise.transition_probability(grid, target, mean, x);
+      std::size_t multi[2];
+      grid.multi_index(target, multi);
+      if (multi[1] != 2) EXPECT_EQ(probability, 0.0);
+      row += probability;
+    }
+    EXPECT_EQ(noise.transition_probability(grid, grid.size() / 2, mean, x), noise.cell_mass(0, 2, 2.2, 0.5));
+    EXPECT_LE(row, 1.0 + kRoundingSlack);
+    // Dimension 0 (standard deviation 0.5) loses its truncation cut and the tails beyond the grid
+    // edges, which are at least 4.6 standard deviations from the mean.
+    constexpr double kEdgeTails = 1e-5;
+    EXPECT_GE(row, 1.0 - noise.cut_mass_bound() - kEdgeTails);
+  }
+  // The face between two cells belongs to the upper one (half-open [lo, hi)).
+  const NoiseModel noise(normal_noise({0.25, 0.0}, Truncation::CuttingProbability), grid);
+  EXPECT_EQ(noise.cell_mass(1, 3, 2.5, 0.0), 1.0);
+  EXPECT_EQ(noise.cell_mass(1, 2, 2.5, 0.0), 0.0);
+}
+
+TEST(ZeroVariance, NegativeVarianceAndSingularFullMatrixRefused) {
+  const Grid grid(grid_spec({0, 0}, {1, 1}, {0.5, 0.5}));
+  try {
+    NoiseModel(normal_noise({0.0, -1e-9}), grid);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(error.key(), "noise.covariance");
+    EXPECT_NE(std::string(error.what()).find(">= 0"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(NoiseModel(normal_noise({0.25, 0.0, 0.0, 0.0}), grid), ConfigError);
+  EXPECT_NO_THROW(NoiseModel(normal_noise({0.0, 0.0}), grid));
 }
 
 TEST(FullCovariance, TooManyDimensionsRefused) {
