@@ -9,6 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -151,6 +155,92 @@ std::vector<DeviceInfo> enumerate_devices() {
   return devices;
 }
 
+
+// --- Program binary cache. Building from source costs ~35-50 ms on pocl even when pocl's own
+// cache holds the compiled kernels (its front end still runs); loading our own copy of the
+// program binary costs ~5 ms. The key hashes everything the binary depends on; any failure to
+// read, write or load an entry silently falls back to building from source.
+std::uint64_t fnv1a(const std::string& text, std::uint64_t hash) {
+  for (unsigned char c : text) {
+    hash ^= c;
+    hash *= 1099511628211ULL;
+  }
+  return hash;
+}
+
+std::string default_kernel_cache_dir() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/amytiss/kernels";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/amytiss/kernels";
+  return "";
+}
+
+std::string cache_entry_path(const DeviceInfo& device, const std::string& source, const std::string& dir) {
+  const std::string material = device_string(device.device, CL_DEVICE_VERSION) + "\n" +
+                               device_string(device.device, CL_DRIVER_VERSION) + "\n" +
+                               platform_string(device.platform, CL_PLATFORM_VERSION) + "\n" +
+                               device.label() + "\n" + source;
+  char name[40];
+  std::snprintf(name, sizeof name, "%016llx%016llx.bin",
+                static_cast<unsigned long long>(fnv1a(material, 14695981039346656037ULL)),
+                static_cast<unsigned long long>(fnv1a(material, 0x9e3779b97f4a7c15ULL)));
+  return dir + "/" + name;
+}
+
+std::string resolved_cache_dir(const std::string& requested) {
+  if (requested == "-") return "";
+  return requested.empty() ? default_kernel_cache_dir() : requested;
+}
+
+Program load_cached_program(cl_context context, const DeviceInfo& device, const std::string& source,
+                            const std::string& requested_dir, std::vector<std::string>& log) {
+  const std::string dir = resolved_cache_dir(requested_dir);
+  if (dir.empty()) return Program();
+  const std::string path = cache_entry_path(device, source, dir);
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Program();
+  const std::vector<unsigned char> binary((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (binary.empty()) return Program();
+  const unsigned char* data = binary.data();
+  const std::size_t size = binary.size();
+  cl_int status = CL_SUCCESS, error = CL_SUCCESS;
+  Program program(clCreateProgramWithBinary(context, 1, &device.device, &size, &data, &status, &error));
+  if (error != CL_SUCCESS || status != CL_SUCCESS) return Program();
+  if (clBuildProgram(program.get(), 1, &device.device, "", nullptr, nullptr) != CL_SUCCESS) return Program();
+  log.push_back("kernel build: program binary from cache " + path);
+  return program;
+}
+
+void store_cached_program(cl_program program, const DeviceInfo& device, const std::string& source,
+                          const std::string& requested_dir, std::vector<std::string>& log) {
+  const std::string dir = resolved_cache_dir(requested_dir);
+  if (dir.empty()) return;
+  std::size_t size = 0;
+  if (clGetProgramInfo(program, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, nullptr) != CL_SUCCESS || size == 0)
+    return;
+  std::vector<unsigned char> binary(size);
+  unsigned char* data = binary.data();
+  if (clGetProgramInfo(program, CL_PROGRAM_BINARIES, sizeof data, &data, nullptr) != CL_SUCCESS) return;
+  std::error_code ignored;
+  std::filesystem::create_directories(dir, ignored);
+  const std::string path = cache_entry_path(device, source, dir);
+  // Written under a unique name and renamed: concurrent runs never see a partial entry.
+  const std::string temporary = path + ".tmp" + std::to_string(static_cast<unsigned long long>(
+                                                    std::chrono::steady_clock::now().time_since_epoch().count()));
+  {
+    std::ofstream file(temporary, std::ios::binary);
+    if (!file.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(size))) {
+      std::filesystem::remove(temporary, ignored);
+      return;
+    }
+  }
+  std::filesystem::rename(temporary, path, ignored);
+  if (ignored) {
+    std::filesystem::remove(temporary, ignored);
+    return;
+  }
+  log.push_back("kernel build: compiled from source, program binary cached in " + path);
+}
+
 std::string lower(std::string text) {
   for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
   return text;
@@ -269,94 +359,120 @@ struct Layout {
   }
 };
 
-// The separable contraction with literal trip counts, nested outermost = dimension 0.
+// The separable contraction, generated with literal trip counts and offsets, nested outermost =
+// dimension 0. Values are double; masses float, converted once. For a window narrower than
+// kUnrollLimit in the last dimension, the last two dimensions are contracted as weighted rows:
+// rows of the last dimension are accumulated with their dimension d-2 mass into double4 vectors
+// (two independent sets, even and odd rows, to keep the FMA latency chains short), and the
+// result is dotted once with the last dimension's masses. Lanes beyond the window carry mass 0
+// (the value buffer has kValueSlack extra zero cells, so the over-read stays in bounds).
 constexpr long long kUnrollLimit = 64;
-std::string contraction_source(const Layout& layout) {
+// Zero cells after the padded values: the last vector of a window row may read up to 3 beyond it.
+constexpr std::size_t kValueSlack = 4;
+std::string contraction_source(const Layout& layout, const std::string& name,
+                               const std::string& mass_space) {
   const std::size_t dims = layout.width.size();
   std::ostringstream s;
-  // Masses and values are stored in float; products and sums are formed in double (exact
-  // products of two floats, sums with 2^-53 rounding), rounded to float once on return: the
-  // worst-case error no longer grows with the window length (docs/engine.md, Precision).
-  s << "float contract(__global const float* v, const float* m) {\n  double acc0 = 0.0;\n";
+  s << "double " << name << "(__global const double* v, " << mass_space << " const float* m) {\n";
+  const long long inner_width = layout.width[dims - 1], inner_offset = layout.mass_offset[dims - 1];
+  const bool rows = inner_width <= kUnrollLimit;
+  const std::size_t outer_levels = rows ? (dims >= 2 ? dims - 2 : 0) : dims - 1;
+  const long long vectors = (inner_width + 3) / 4;
+  if (rows) {
+    for (long long k = 0; k < vectors; ++k) {
+      s << "  const double4 inner_mass" << k << " = ";
+      if (4 * k + 4 <= inner_width) {
+        s << "convert_double4(vload4(0, m + " << inner_offset + 4 * k << "));\n";
+      } else {
+        s << "(double4)(";
+        for (long long lane = 0; lane < 4; ++lane) {
+          const long long j = 4 * k + lane;
+          s << (lane ? ", " : "") << (j < inner_width ? "(double)m[" + std::to_string(inner_offset + j) + "]" : "0.0");
+        }
+        s << ");\n";
+      }
+    }
+  }
+  // Opens the outer loops (scalar FMA chains, zero-mass rows skipped).
   std::string pointer = "v";
-  std::size_t closing = 0;  // loops opened
-  for (std::size_t i = 0; i < dims; ++i) {
-    const std::string a = "a" + std::to_string(i), acc = "acc" + std::to_string(i);
-    const std::string indent(2 * (i + 1), ' ');
-    const bool innermost = i + 1 == dims;
-    if (innermost && layout.width[i] <= kUnrollLimit) {
-      // Innermost row (padded stride 1): explicit vectors of 8/4/2/1 lanes, then a balanced
-      // sum. pocl does not vectorize this kernel across work-items, and a serial accumulation
-      // would be bound by the FMA latency.
-      std::vector<std::string> terms;
-      long long j = 0;
-      for (long long lanes : {8LL, 4LL, 2LL}) {
-        while (layout.width[i] - j >= lanes) {
-          const std::string n = std::to_string(lanes);
-          terms.push_back("convert_double" + n + "(vload" + n + "(0, m + " + std::to_string(layout.mass_offset[i] + j) +
-                          ")) * convert_double" + n + "(vload" + n + "(0, " + pointer + " + " + std::to_string(j) + "))");
-          j += lanes;
-        }
-      }
-      if (j < layout.width[i])
-        terms.push_back("(double)m[" + std::to_string(layout.mass_offset[i] + j) + "] * (double)" + pointer + "[" +
-                        std::to_string(j) + "]");
-      // Reduce each vector term to a scalar by halving (s.lo + s.hi), then sum the scalars.
-      std::vector<std::string> scalars;
-      for (std::size_t t = 0; t < terms.size(); ++t) {
-        const std::string name = "row" + std::to_string(t);
-        const bool vector = terms[t].rfind("convert_double", 0) == 0;
-        const std::string width = vector ? terms[t].substr(14, 1) : "1";
-        if (!vector) {
-          scalars.push_back("(" + terms[t] + ")");
-          continue;
-        }
-        s << indent << "double" << width << " " << name << " = " << terms[t] << ";\n";
-        std::string current = name;
-        int lanes = std::stoi(width);
-        while (lanes > 1) {
-          const std::string next = name + "_" + std::to_string(lanes / 2);
-          s << indent << (lanes / 2 > 1 ? "double" + std::to_string(lanes / 2) : std::string("double")) << " " << next
-            << " = " << current << ".lo + " << current << ".hi;\n";
-          current = next;
-          lanes /= 2;
-        }
-        scalars.push_back(current);
-      }
-      while (scalars.size() > 1) {
-        std::vector<std::string> paired;
-        for (std::size_t t = 0; t + 1 < scalars.size(); t += 2)
-          paired.push_back("(" + scalars[t] + " + " + scalars[t + 1] + ")");
-        if (scalars.size() % 2) paired.push_back(scalars.back());
-        scalars = paired;
-      }
-      s << indent << acc << " = " << scalars.front() << ";\n";
-      break;
-    }
+  for (std::size_t i = 0; i < outer_levels; ++i) {
+    const std::string indent(2 * (i + 1), ' '), a = "a" + std::to_string(i);
+    s << indent << "double acc" << i << " = 0.0;\n";
     s << indent << "for (int " << a << " = 0; " << a << " < " << layout.width[i] << "; ++" << a << ") {\n";
-    ++closing;
-    const std::string mass = "m[" + std::to_string(layout.mass_offset[i]) + " + " + a + "]";
-    if (innermost) {
-      s << indent << "  " << acc << " = fma((double)" << mass << ", (double)" << pointer << "[" << a << " * "
-        << layout.padded_stride[i] << "], " << acc << ");\n";
+    s << indent << "  const double mass" << i << " = m[" << layout.mass_offset[i] << " + " << a << "];\n";
+    s << indent << "  if (mass" << i << " == 0.0) continue;\n";
+    s << indent << "  __global const double* v" << i << " = " << pointer << " + " << a << " * "
+      << layout.padded_stride[i] << ";\n";
+    pointer = "v" + std::to_string(i);
+  }
+  const std::string indent(2 * (outer_levels + 1), ' ');
+  if (rows) {
+    // The weighted rows of dimension d-2 (a single row of weight 1 when dims == 1).
+    auto row_load = [&](const std::string& row_pointer, long long k) {
+      return "vload4(" + std::to_string(k) + ", " + row_pointer + ")";
+    };
+    std::vector<std::string> summed(vectors);
+    if (dims == 1) {
+      for (long long k = 0; k < vectors; ++k) summed[k] = row_load(pointer, k);
     } else {
-      const std::string next_pointer = "v" + std::to_string(i);
-      s << indent << "  const double mass" << i << " = " << mass << ";\n";
-      // Rows outside the grid or the truncation region carry zero mass: skip them.
-      s << indent << "  if (mass" << i << " == 0.0) continue;\n";
-      s << indent << "  __global const float* " << next_pointer << " = " << pointer << " + " << a
-        << " * " << layout.padded_stride[i] << ";\n";
-      s << indent << "  double acc" << i + 1 << " = 0.0;\n";
-      pointer = next_pointer;
+      const std::size_t r = dims - 2;
+      const long long row_width = layout.width[r], row_offset = layout.mass_offset[r],
+                      row_stride = layout.padded_stride[r];
+      const bool two_sets = row_width >= 2;
+      for (long long k = 0; k < vectors; ++k) {
+        s << indent << "double4 even" << k << " = 0.0;\n";
+        if (two_sets) s << indent << "double4 odd" << k << " = 0.0;\n";
+      }
+      auto accumulate = [&](const std::string& set, const std::string& row) {
+        s << indent << "  {\n" << indent << "    const double weight = m[" << row_offset << " + " << row << "];\n"
+          << indent << "    __global const double* row = " << pointer << " + (" << row << ") * " << row_stride << ";\n";
+        for (long long k = 0; k < vectors; ++k)
+          s << indent << "    " << set << k << " = fma((double4)(weight), " << row_load("row", k) << ", " << set << k
+            << ");\n";
+        s << indent << "  }\n";
+      };
+      if (two_sets) {
+        s << indent << "for (int r = 0; r + 1 < " << row_width << "; r += 2) {\n";
+        accumulate("even", "r");
+        accumulate("odd", "r + 1");
+        s << indent << "}\n";
+      }
+      if (row_width % 2) {
+        s << indent << "{\n" << indent << "  const int r = " << row_width - 1 << ";\n";
+        accumulate("even", "r");
+        s << indent << "}\n";
+      }
+      for (long long k = 0; k < vectors; ++k)
+        summed[k] = two_sets ? "(even" + std::to_string(k) + " + odd" + std::to_string(k) + ")" : "even" + std::to_string(k);
     }
+    std::vector<std::string> terms;
+    for (long long k = 0; k < vectors; ++k) terms.push_back("inner_mass" + std::to_string(k) + " * " + summed[k]);
+    while (terms.size() > 1) {
+      std::vector<std::string> paired;
+      for (std::size_t t = 0; t + 1 < terms.size(); t += 2) paired.push_back("(" + terms[t] + " + " + terms[t + 1] + ")");
+      if (terms.size() % 2) paired.push_back(terms.back());
+      terms = paired;
+    }
+    s << indent << "const double4 lanes = " << terms.front() << ";\n";
+    s << indent << "const double2 halves = lanes.lo + lanes.hi;\n";
+    s << indent << "const double rows = halves.x + halves.y;\n";
+  } else {
+    s << indent << "double rows = 0.0;\n";
+    s << indent << "for (int j = 0; j < " << inner_width << "; ++j)\n";
+    s << indent << "  rows = fma((double)m[" << inner_offset << " + j], " << pointer << "[j], rows);\n";
   }
-  for (std::size_t i = closing; i-- > 0;) {
-    const std::string indent(2 * (i + 1), ' ');
-    if (i + 1 < dims)
-      s << indent << "  acc" << i << " = fma(mass" << i << ", acc" << i + 1 << ", acc" << i << ");\n";
-    s << indent << "}\n";
+  if (outer_levels == 0) {
+    s << "  return rows;\n}\n";
+    return s.str();
   }
-  s << "  return (float)acc0;\n}\n";
+  s << indent << "acc" << outer_levels - 1 << " = fma(mass" << outer_levels - 1 << ", rows, acc" << outer_levels - 1
+    << ");\n";
+  for (std::size_t i = outer_levels; i-- > 0;) {
+    const std::string close_indent(2 * (i + 1), ' ');
+    s << close_indent << "}\n";
+    if (i > 0) s << close_indent << "acc" << i - 1 << " = fma(mass" << i - 1 << ", acc" << i << ", acc" << i - 1 << ");\n";
+  }
+  s << "  return acc0;\n}\n";
   return s.str();
 }
 
@@ -419,7 +535,8 @@ std::string opencl_program_source(const Abstraction& a, bool on_the_fly, std::si
     << constant_array("double", "DIST_ETA", a.disturbances.eta(), real)
     << constant_array("int", "DIST_COUNT", counts_of(a.disturbances), integer)
     << constant_array("double", "NOISE_SCALE", noise.base_scale(), real);
-  s << contraction_source(layout);
+  s << contraction_source(layout, "contract_global", "__global")
+    << contraction_source(layout, "contract_private", "");
   s << a.dynamics->opencl_source() << "\n";
   s << embedded_source("engine.cl");
   return s.str();
@@ -471,7 +588,8 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
   // --- memory plan: stored when the records fit the budget, else on the fly
   const std::size_t record_bytes = sizeof(cl_uint) + sizeof(float) * std::size_t(layout.mass_record);
   const std::size_t records_per_state = n_inputs * n_dists;
-  const std::size_t base_bytes = 2 * layout.padded_size * sizeof(float) + n_states * (1 + sizeof(cl_uint));
+  const std::size_t value_cells = layout.padded_size + kValueSlack;
+  const std::size_t base_bytes = 2 * value_cells * sizeof(double) + n_states * (1 + sizeof(cl_uint));
   const double budget = options.compute.memory_fraction * double(device.global_memory);
   const double stored_bytes = double(n_states) * double(records_per_state) * double(record_bytes);
   const std::size_t max_states_by_allocation = std::max<std::size_t>(
@@ -515,19 +633,23 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
   // --- kernel build
   phase_start = Clock::now();
   const std::string source = opencl_program_source(a, on_the_fly, group_size);
-  const char* source_text = source.c_str();
-  const std::size_t source_length = source.size();
-  Program program(clCreateProgramWithSource(context.get(), 1, &source_text, &source_length, &error));
-  check(error, "clCreateProgramWithSource");
-  error = clBuildProgram(program.get(), 1, &device.device, "", nullptr, nullptr);
-  if (error != CL_SUCCESS) {
-    std::size_t log_size = 0;
-    clGetProgramBuildInfo(program.get(), device.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &log_size);
-    std::string build_log(log_size, '\0');
-    clGetProgramBuildInfo(program.get(), device.device, CL_PROGRAM_BUILD_LOG, log_size,
-                          build_log.data(), nullptr);
-    throw DeviceError("OpenCL kernel build failed on " + device.label() + " (" +
-                      cl_error_name(error) + "); compiler log:\n" + build_log);
+  Program program = load_cached_program(context.get(), device, source, engine_options.kernel_cache_dir, rep.log);
+  if (!program.get()) {
+    const char* source_text = source.c_str();
+    const std::size_t source_length = source.size();
+    program = Program(clCreateProgramWithSource(context.get(), 1, &source_text, &source_length, &error));
+    check(error, "clCreateProgramWithSource");
+    error = clBuildProgram(program.get(), 1, &device.device, "", nullptr, nullptr);
+    if (error != CL_SUCCESS) {
+      std::size_t log_size = 0;
+      clGetProgramBuildInfo(program.get(), device.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &log_size);
+      std::string build_log(log_size, '\0');
+      clGetProgramBuildInfo(program.get(), device.device, CL_PROGRAM_BUILD_LOG, log_size,
+                            build_log.data(), nullptr);
+      throw DeviceError("OpenCL kernel build failed on " + device.label() + " (" +
+                        cl_error_name(error) + "); compiler log:\n" + build_log);
+    }
+    store_cached_program(program.get(), device, source, engine_options.kernel_cache_dir, rep.log);
   }
   Kernel construct(clCreateKernel(program.get(), "construct", &error));
   check(error, "clCreateKernel(construct)");
@@ -546,7 +668,8 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
     return buffer;
   };
   std::vector<cl_uchar> roles(n_states);
-  std::vector<float> terminal(layout.padded_size, 0.0f);
+  std::vector<double> terminal(value_cells, 0.0);
+  std::vector<std::size_t> padded_index(n_states);  // cell -> its place in the padded array
   std::size_t free_states = 0;
   for (std::size_t x = 0; x < n_states; ++x) {
     roles[x] = static_cast<cl_uchar>(a.roles[x]);
@@ -554,12 +677,13 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
     const double value = a.roles[x] == CellRole::FixedOne ? 1.0
                          : a.roles[x] == CellRole::FixedZero ? 0.0
                                                              : a.terminal_value(CellRole::Free);
-    terminal[layout.padded_offset(a.states, x)] = float(value);
+    padded_index[x] = layout.padded_offset(a.states, x);
+    terminal[padded_index[x]] = value;
   }
   Buffer roles_buffer = make_buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n_states, roles.data());
   Buffer values[2] = {
-      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, layout.padded_size * sizeof(float), terminal.data()),
-      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, layout.padded_size * sizeof(float), terminal.data())};
+      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, value_cells * sizeof(double), terminal.data()),
+      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, value_cells * sizeof(double), terminal.data())};
   Buffer best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
 
   // Chunks of states: bounded by the allocation limit (stored) and by a launch size that keeps
@@ -590,7 +714,10 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
   rep.device_bytes = device_bytes;
   rep.log.push_back("device memory: " + mib(double(device_bytes)));
 
-  const std::size_t item_group = 64;
+  // Construction: 64 triples per work-group. Sweep (ItemPerState): 16 states per work-group, so
+  // that pocl's threads can balance groups of unequal cost (fixed cells are free of work):
+  // robot reach-avoid has 106 groups instead of 27, ~5% faster sweep than 64 (BENCHMARKS.md).
+  const std::size_t construct_group = 64, item_group = 16;
   auto round_up = [](std::size_t value, std::size_t multiple) { return (value + multiple - 1) / multiple * multiple; };
 
   // --- construction (Algorithm 2)
@@ -603,8 +730,8 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
       check(clSetKernelArg(construct.get(), 1, sizeof(cl_ulong), &triple_count), "clSetKernelArg");
       check(clSetKernelArg(construct.get(), 2, sizeof(cl_mem), &chunk.starts.handle), "clSetKernelArg");
       check(clSetKernelArg(construct.get(), 3, sizeof(cl_mem), &chunk.masses.handle), "clSetKernelArg");
-      const std::size_t global = round_up(std::size_t(triple_count), item_group);
-      check(clEnqueueNDRangeKernel(queue.get(), construct.get(), 1, nullptr, &global, &item_group, 0,
+      const std::size_t global = round_up(std::size_t(triple_count), construct_group);
+      check(clEnqueueNDRangeKernel(queue.get(), construct.get(), 1, nullptr, &global, &construct_group, 0,
                                    nullptr, nullptr),
             "clEnqueueNDRangeKernel(construct)");
     }
@@ -627,8 +754,13 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
   policy.config_hash = config_hash(a.config);
   policy.values.assign((std::size_t(a.horizon) + 1) * n_states, 0.0);
   policy.input_index.assign(std::size_t(a.horizon) * n_states, 0);
-  std::vector<float> padded_values((std::size_t(a.horizon) + 1) * layout.padded_size);
-  std::copy(terminal.begin(), terminal.end(), padded_values.begin() + std::size_t(a.horizon) * layout.padded_size);
+  // One padded step at a time comes back to the host and is unpadded into the policy at once.
+  std::vector<double> step_values(layout.padded_size);
+  auto unpad = [&](unsigned step, const double* padded) {
+    double* out = policy.values.data() + std::size_t(step) * n_states;
+    for (std::size_t x = 0; x < n_states; ++x) out[x] = padded[padded_index[x]];
+  };
+  unpad(a.horizon, terminal.data());
 
   const double multiply_adds_per_step =
       double(free_states) * double(records_per_state) * contraction_multiply_adds(a);
@@ -662,12 +794,13 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
                               policy.input_index.data() + std::size_t(step) * n_states, 0, nullptr, nullptr),
           "clEnqueueReadBuffer");
     check(clEnqueueReadBuffer(queue.get(), values[1 - current].get(), CL_FALSE, 0,
-                              layout.padded_size * sizeof(float),
-                              padded_values.data() + std::size_t(step) * layout.padded_size, 0, nullptr, nullptr),
+                              layout.padded_size * sizeof(double),
+                              step_values.data(), 0, nullptr, nullptr),
           "clEnqueueReadBuffer");
     check(clFinish(queue.get()), "clFinish(synthesize)");
     current = 1 - current;
     const double seconds = seconds_since(phase_start);
+    unpad(step, step_values.data());
     rep.phases.push_back({"step " + std::to_string(step), seconds,
                           double(a.pairs()) / std::max(seconds, 1e-9), multiply_adds_per_step});
     const unsigned done = a.horizon - step;
@@ -675,10 +808,6 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
     report_progress(done == a.horizon ? "done" : "synthesis", done, remaining);
   }
 
-  for (std::size_t step = 0; step <= a.horizon; ++step)
-    for (std::size_t x = 0; x < n_states; ++x)
-      policy.values[step * n_states + x] =
-          double(padded_values[step * layout.padded_size + layout.padded_offset(a.states, x)]);
   rep.host_peak_bytes = peak_resident_bytes();
   return policy;
 }

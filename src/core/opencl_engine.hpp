@@ -21,6 +21,9 @@ struct OpenClEngineOptions {
   SweepVariant variant = SweepVariant::Auto;
   /// Upper bound of states per chunk (stored buffers and launches); 0: chosen from device limits.
   std::size_t max_states_per_chunk = 0;
+  /// Folder of the program binary cache; empty: $XDG_CACHE_HOME/amytiss/kernels or
+  /// ~/.cache/amytiss/kernels; "-": no cache (always build from source).
+  std::string kernel_cache_dir;
 };
 
 /// The OpenCL engine (device chosen by options.compute, see synthesize()).

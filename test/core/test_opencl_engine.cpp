@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -297,7 +299,7 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
   const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
-                                                  {SweepVariant::ItemPerState, 0});
+                                                  {SweepVariant::ItemPerState, 0, {}});
   EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
   struct Variant {
     const char* name;
@@ -305,11 +307,11 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     OpenClEngineOptions engine;
   };
   const Variant variants[] = {
-      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0}},
-      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0}},
-      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0}},
-      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37}},
-      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50}},
+      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}}},
   };
   for (const Variant& variant : variants) {
     SynthesisReport report;
@@ -321,10 +323,11 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
       return line.find(group ? "work-group" : "work-item") != std::string::npos;
     });
     EXPECT_TRUE(logged) << variant.name << ": the sweep variant that ran is logged";
-    if (variant.engine.max_states_per_chunk)
+    if (variant.engine.max_states_per_chunk) {
       EXPECT_TRUE(std::any_of(report.log.begin(), report.log.end(),
                               [](const std::string& line) { return line.find("chunks") != std::string::npos; }))
           << variant.name;
+    }
   }
 }
 
@@ -419,6 +422,62 @@ TEST(OpenClEngine, UnknownDeviceSelectionIsADeviceError) {
   SynthesisOptions options = cpu_options();
   options.compute.platform = "no-such-platform-name";
   EXPECT_THROW(synthesize(a, options), DeviceError);
+}
+
+// The last dimension's window wider than the unrolled vector form (64 cells): the contraction
+// falls back to a scalar loop over that dimension; both forms must agree with the reference.
+TEST(OpenClEngine, WideLastDimensionWindowUsesTheScalarContractionAndAgrees) {
+  const Abstraction wide = from_yaml(
+      "name: wide\n"
+      "states: {lb: [-1, -5], ub: [1, 5], eta: [0.5, 0.1]}\n"
+      "inputs: {lb: [-1], ub: [1], eta: [1.0]}\n"
+      "dynamics: [\"0.5*x0 + 0.5*u0\", \"0.9*x1 + u0\"]\n"
+      "noise: {type: additive, distribution: normal, covariance: [0.04, 1.0], truncation: none}\n"
+      "spec: {type: safety, horizon: 3, safe: {lb: [-1, -4], ub: [1, 4]}}\n");
+  const std::string wide_source = detail::opencl_program_source(wide, false, 1);
+  EXPECT_EQ(wide_source.find("double4 even0"), std::string::npos) << "scalar form expected";
+  EXPECT_NE(wide_source.find("j < 201"), std::string::npos) << "window of 2 * 100 + 1 cells";
+  expect_agreement("wide last dimension (scalar contraction)", wide, TransitionStorage::Stored);
+  const std::string robot_source =
+      detail::opencl_program_source(from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2)), false, 1);
+  EXPECT_NE(robot_source.find("double4 even0"), std::string::npos) << "vector row form expected";
+}
+
+// Program binaries are cached on disk: the second run loads the binary (no front end) and gives
+// bit-identical results; a corrupt entry is ignored (built from source again and overwritten).
+TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.4, 3));
+  const std::string cache = ::testing::TempDir() + "amytiss_kernel_cache_" +
+                            std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
+  OpenClEngineOptions engine;
+  engine.kernel_cache_dir = cache;
+  auto logged = [](const SynthesisReport& report, const std::string& text) {
+    return std::any_of(report.log.begin(), report.log.end(),
+                       [&](const std::string& line) { return line.find(text) != std::string::npos; });
+  };
+  SynthesisReport first_report, second_report, third_report, uncached_report;
+  const Policy first = detail::synthesize_opencl(a, cpu_options(), &first_report, engine);
+  EXPECT_TRUE(logged(first_report, "compiled from source, program binary cached in " + cache));
+  const Policy second = detail::synthesize_opencl(a, cpu_options(), &second_report, engine);
+  EXPECT_TRUE(logged(second_report, "program binary from cache " + cache));
+  EXPECT_EQ(second.values, first.values);
+  EXPECT_EQ(second.input_index, first.input_index);
+
+  std::size_t entries = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(cache)) {
+    ++entries;
+    std::ofstream(entry.path(), std::ios::binary | std::ios::trunc) << "not a program binary";
+  }
+  EXPECT_EQ(entries, 1u);
+  const Policy third = detail::synthesize_opencl(a, cpu_options(), &third_report, engine);
+  EXPECT_TRUE(logged(third_report, "compiled from source")) << "corrupt entry must be ignored";
+  EXPECT_EQ(third.values, first.values);
+
+  engine.kernel_cache_dir = "-";
+  const Policy uncached = detail::synthesize_opencl(a, cpu_options(), &uncached_report, engine);
+  EXPECT_FALSE(logged(uncached_report, "kernel build:")) << "\"-\" disables the cache";
+  EXPECT_EQ(uncached.values, first.values);
+  std::filesystem::remove_all(cache);
 }
 
 TEST(OpenClEngine, RobotReachAvoidFullGridAgreesWithReference) {
