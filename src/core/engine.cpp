@@ -1,9 +1,43 @@
-// synthesize(): dispatch to the reference or the OpenCL engine.
+// synthesize(): dispatch to the reference or the OpenCL engine, with the CPU fallback of SPEC 7.
 #include "amytiss/engine.hpp"
 
+#include "amytiss/errors.hpp"
 #include "opencl_engine.hpp"
 
 namespace amytiss {
+
+namespace detail {
+
+Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisReport* report,
+                                    const EngineAttempt& attempt, const DeviceLabel& cpu_label) {
+  SynthesisReport local_report;
+  SynthesisReport& first_report = report ? *report : local_report;
+  try {
+    return attempt(options, &first_report);
+  } catch (const DeviceError& failure) {
+    if (options.compute.device == DeviceKind::Cpu) throw;
+    ComputeConfig on_cpu = options.compute;
+    on_cpu.device = DeviceKind::Cpu;
+    on_cpu.platform.clear();
+    on_cpu.device_name.clear();
+    const std::string fallback_device = cpu_label(on_cpu);
+    // Running the device that just failed again would only fail again.
+    if (fallback_device.empty() || fallback_device == first_report.device) throw;
+    SynthesisReport retry_report;
+    retry_report.log = first_report.log;
+    retry_report.log.push_back("warning: " + (first_report.device.empty() ? std::string("the device")
+                                                                          : first_report.device) +
+                               " failed (" + failure.what() + "); falling back to the CPU device " +
+                               fallback_device);
+    SynthesisOptions retry_options = options;
+    retry_options.compute = on_cpu;
+    Policy policy = attempt(retry_options, &retry_report);
+    first_report = std::move(retry_report);
+    return policy;
+  }
+}
+
+}  // namespace detail
 
 Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
                   SynthesisReport* report) {
@@ -11,7 +45,12 @@ Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& option
     if (report) report->log.push_back("device: reference (serial, double precision)");
     return synthesize_reference(abstraction, options.progress, report);
   }
-  return detail::synthesize_opencl(abstraction, options, report);
+  return detail::synthesize_with_cpu_fallback(
+      options, report,
+      [&abstraction](const SynthesisOptions& attempt_options, SynthesisReport* attempt_report) {
+        return detail::synthesize_opencl(abstraction, attempt_options, attempt_report);
+      },
+      detail::selected_device_label);
 }
 
 }  // namespace amytiss

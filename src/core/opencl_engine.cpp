@@ -812,6 +812,15 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options,
   return policy;
 }
 
+std::string selected_device_label(const ComputeConfig& compute) {
+  std::vector<std::string> ignored_log;
+  try {
+    return choose_device(compute, ignored_log).label();
+  } catch (const DeviceError&) {
+    return "";
+  }
+}
+
 }  // namespace detail
 
 std::vector<std::string> list_opencl_devices() {

@@ -1,6 +1,7 @@
 #pragma once
 // Internal interface of the OpenCL engine (not installed; tests include it through src/core).
 #include <cstddef>
+#include <functional>
 #include <string>
 
 #include "amytiss/abstraction.hpp"
@@ -29,6 +30,18 @@ struct OpenClEngineOptions {
 /// The OpenCL engine (device chosen by options.compute, see synthesize()).
 Policy synthesize_opencl(const Abstraction& abstraction, const SynthesisOptions& options,
                          SynthesisReport* report, const OpenClEngineOptions& engine_options = {});
+
+/// Label ("platform / device") of the device that `compute` selects, or "" when none matches.
+std::string selected_device_label(const ComputeConfig& compute);
+
+/// One attempt of an engine run, and the label of the CPU device a fallback would use.
+using EngineAttempt = std::function<Policy(const SynthesisOptions&, SynthesisReport*)>;
+using DeviceLabel = std::function<std::string(const ComputeConfig&)>;
+/// SPEC section 7: a device that fails (DeviceError) is retried once on the CPU device, with a
+/// warning in report->log, unless the failing device is that CPU device or `cpu` was asked for.
+/// synthesize() calls it with synthesize_opencl; tests call it with failing attempts.
+Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisReport* report,
+                                    const EngineAttempt& attempt, const DeviceLabel& cpu_label);
 
 /// The OpenCL C source built for a problem: generated prelude + dynamics + engine.cl.
 std::string opencl_program_source(const Abstraction& abstraction, bool on_the_fly,

@@ -1,0 +1,124 @@
+// SPEC section 7: a failing device falls back to the CPU device with a warning.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "amytiss/errors.hpp"
+#include "opencl_engine.hpp"
+
+namespace amytiss {
+namespace {
+
+const std::string kGpuLabel = "NVIDIA CUDA / NVIDIA H100";
+const std::string kCpuLabel = "Portable Computing Language / pthread";
+
+// An attempt that fails on every device but the CPU one and records what it was asked for.
+struct ScriptedEngine {
+  std::vector<DeviceKind> requested;
+  bool cpu_fails = false;
+
+  Policy operator()(const SynthesisOptions& options, SynthesisReport* report) {
+    requested.push_back(options.compute.device);
+    const bool on_cpu = options.compute.device == DeviceKind::Cpu;
+    report->device = on_cpu ? kCpuLabel : kGpuLabel;
+    report->log.push_back("attempt on " + report->device);
+    if (!on_cpu || cpu_fails) throw DeviceError("clEnqueueNDRangeKernel failed: CL_OUT_OF_RESOURCES");
+    Policy policy;
+    policy.computed_by = report->device;
+    return policy;
+  }
+};
+
+detail::DeviceLabel cpu_device_is(const std::string& label) {
+  return [label](const ComputeConfig&) { return label; };
+}
+
+SynthesisOptions options_for(DeviceKind device) {
+  SynthesisOptions options;
+  options.compute.device = device;
+  options.compute.platform = "nvidia";
+  return options;
+}
+
+TEST(EngineFallback, FailingGpuIsRetriedOnTheCpuDeviceWithAWarning) {
+  ScriptedEngine engine;
+  SynthesisReport report;
+  const Policy policy = detail::synthesize_with_cpu_fallback(
+      options_for(DeviceKind::Gpu), &report, std::ref(engine), cpu_device_is(kCpuLabel));
+
+  EXPECT_EQ(policy.computed_by, kCpuLabel);
+  ASSERT_EQ(engine.requested.size(), 2u);
+  EXPECT_EQ(engine.requested[1], DeviceKind::Cpu);
+  EXPECT_EQ(report.device, kCpuLabel);
+  bool warned = false;
+  for (const auto& line : report.log)
+    warned = warned || (line.rfind("warning: " + kGpuLabel + " failed (", 0) == 0 &&
+                        line.find("CL_OUT_OF_RESOURCES") != std::string::npos &&
+                        line.find("falling back to the CPU device " + kCpuLabel) != std::string::npos);
+  EXPECT_TRUE(warned) << "no fallback warning in the report log";
+}
+
+TEST(EngineFallback, AutoFallsBackToo) {
+  ScriptedEngine engine;
+  const Policy policy = detail::synthesize_with_cpu_fallback(
+      options_for(DeviceKind::Auto), nullptr, std::ref(engine), cpu_device_is(kCpuLabel));
+  EXPECT_EQ(policy.computed_by, kCpuLabel);
+  EXPECT_EQ(engine.requested.size(), 2u);
+}
+
+TEST(EngineFallback, ExplicitCpuRequestIsNotRetried) {
+  ScriptedEngine engine;
+  engine.cpu_fails = true;
+  EXPECT_THROW(detail::synthesize_with_cpu_fallback(options_for(DeviceKind::Cpu), nullptr,
+                                                    std::ref(engine), cpu_device_is(kCpuLabel)),
+               DeviceError);
+  EXPECT_EQ(engine.requested.size(), 1u);
+}
+
+TEST(EngineFallback, NoRetryWhenTheFailingDeviceIsTheCpuDeviceOrThereIsNone) {
+  ScriptedEngine engine;
+  EXPECT_THROW(detail::synthesize_with_cpu_fallback(options_for(DeviceKind::Gpu), nullptr,
+                                                    std::ref(engine), cpu_device_is(kGpuLabel)),
+               DeviceError);
+  EXPECT_EQ(engine.requested.size(), 1u);
+
+  ScriptedEngine no_cpu;
+  EXPECT_THROW(detail::synthesize_with_cpu_fallback(options_for(DeviceKind::Gpu), nullptr,
+                                                    std::ref(no_cpu), cpu_device_is("")),
+               DeviceError);
+  EXPECT_EQ(no_cpu.requested.size(), 1u);
+}
+
+TEST(EngineFallback, CpuFailureAfterFallbackPropagates) {
+  ScriptedEngine engine;
+  engine.cpu_fails = true;
+  EXPECT_THROW(detail::synthesize_with_cpu_fallback(options_for(DeviceKind::Gpu), nullptr,
+                                                    std::ref(engine), cpu_device_is(kCpuLabel)),
+               DeviceError);
+  EXPECT_EQ(engine.requested.size(), 2u);
+}
+
+TEST(EngineFallback, CancellationIsNotADeviceFailure) {
+  int attempts = 0;
+  const detail::EngineAttempt cancelled = [&attempts](const SynthesisOptions&, SynthesisReport*) -> Policy {
+    ++attempts;
+    throw Cancelled();
+  };
+  EXPECT_THROW(detail::synthesize_with_cpu_fallback(options_for(DeviceKind::Gpu), nullptr, cancelled,
+                                                    cpu_device_is(kCpuLabel)),
+               Cancelled);
+  EXPECT_EQ(attempts, 1);
+}
+
+TEST(EngineFallback, SelectedDeviceLabelNamesTheCpuDeviceOfThisMachine) {
+  ComputeConfig compute;
+  compute.device = DeviceKind::Cpu;
+  // Every machine that runs the tests has pocl's CPU device (CI included).
+  EXPECT_NE(detail::selected_device_label(compute), "");
+  compute.platform = "no platform has this name";
+  EXPECT_EQ(detail::selected_device_label(compute), "");
+}
+
+}  // namespace
+}  // namespace amytiss
