@@ -408,7 +408,9 @@ TEST(ZeroVariance, DiagonalZeroIsAPointMassWithAOneCellWindow) {
       const double probability = noise.transition_probability(grid, target, mean, x);
       std::size_t multi[2];
       grid.multi_index(target, multi);
-      if (multi[1] != 2) EXPECT_EQ(probability, 0.0);
+      if (multi[1] != 2) {
+        EXPECT_EQ(probability, 0.0);
+      }
       row += probability;
     }
     EXPECT_EQ(noise.transition_probability(grid, grid.size() / 2, mean, x), noise.cell_mass(0, 2, 2.2, 0.5));
