@@ -110,6 +110,10 @@ class NoiseModel {
   std::size_t grid_size_ = 1;
 };
 
+/// Lower-triangular Cholesky factor L (row-major n*n, matrix = L L^T) of a symmetric n*n matrix
+/// (row-major, only its lower triangle is read). Throws ConfigError (key noise.covariance) when
+/// the matrix is not positive definite.
+std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size_t n);
 /// Standard normal upper tail quantile: z with 1 - Phi(z) = p, for p in (0, 0.5].
 double normal_upper_quantile(double p);
 

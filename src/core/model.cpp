@@ -8,6 +8,7 @@
 namespace amytiss {
 namespace builtin {
 // The model sources are plain C shared with the OpenCL kernels; they use the global math functions.
+#include "models/model_function.h"
 #include "models/bmw320i.h"
 #include "models/vehicle3d.h"
 }  // namespace builtin
@@ -62,7 +63,7 @@ class BuiltinDynamics : public Dynamics {
   }
 
   std::string opencl_source() const override {
-    return std::string(detail::embedded_source(info_.name + ".h")) +
+    return std::string(detail::embedded_source("model_function.h")) + detail::embedded_source(info_.name + ".h") +
            "\nvoid amytiss_dynamics(const double* x, const double* u, const double* w, double* post) {\n"
            "  amytiss_model_" + info_.name + "(x, u, w, post);\n}\n";
   }

@@ -76,6 +76,29 @@ std::string number(double value) {
 
 }  // namespace
 
+std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size_t n) {
+  std::vector<double> factor(n * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j <= i; ++j) {
+      double sum = matrix.at(i * n + j);
+      for (std::size_t k = 0; k < j; ++k) sum -= factor[i * n + k] * factor[j * n + k];
+      if (i == j) {
+        // A non-positive (or NaN) pivot means the matrix is not positive definite.
+        if (!(sum > 0))
+          throw ConfigError("noise.covariance",
+                            "the matrix is not positive definite (pivot " + std::to_string(i) + " is " +
+                                number(sum) +
+                                "); expected positive variances (example: covariance: [0.75, 0.75]; a "
+                                "dimension without noise needs the diagonal form with variance 0)");
+        factor[i * n + i] = std::sqrt(sum);
+      } else {
+        factor[i * n + j] = sum / factor[j * n + j];
+      }
+    }
+  }
+  return factor;
+}
+
 double normal_upper_quantile(double p) {
   if (!(p > 0.0 && p <= 0.5))
     throw std::invalid_argument("normal_upper_quantile: p = " + number(p) + ", expected 0 < p <= 0.5");
@@ -153,28 +176,11 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
                                                     std::to_string(j) + "," + std::to_string(i) +
                                                     ") = " + number(covariance_[j * n + i]));
       }
-    // Cholesky; a non-positive pivot means the matrix is not positive definite.
-    cholesky_.assign(n * n, 0.0);
     if (diagonal_form) {
+      cholesky_.assign(n * n, 0.0);
       for (std::size_t i = 0; i < n; ++i) cholesky_[i * n + i] = std::sqrt(covariance_[i * n + i]);
     } else {
-      for (std::size_t i = 0; i < n; ++i) {
-        for (std::size_t j = 0; j <= i; ++j) {
-          double sum = covariance_[i * n + j];
-          for (std::size_t k = 0; k < j; ++k) sum -= cholesky_[i * n + k] * cholesky_[j * n + k];
-          if (i == j) {
-            if (!(sum > 0))
-              throw ConfigError("noise.covariance",
-                                "the matrix is not positive definite (pivot " + std::to_string(i) + " is " +
-                                    number(sum) +
-                                    "); expected positive variances (example: covariance: [0.75, 0.75]; a "
-                                    "dimension without noise needs the diagonal form with variance 0)");
-            cholesky_[i * n + i] = std::sqrt(sum);
-          } else {
-            cholesky_[i * n + j] = sum / cholesky_[j * n + j];
-          }
-        }
-      }
+      cholesky_ = cholesky_factor(covariance_, n);
     }
     separable_ = true;
     for (std::size_t i = 0; i < n; ++i)

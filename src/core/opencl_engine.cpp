@@ -81,21 +81,22 @@ using Program = ClHandle<cl_program, clReleaseProgram>;
 using Kernel = ClHandle<cl_kernel, clReleaseKernel>;
 using Buffer = ClHandle<cl_mem, clReleaseMemObject>;
 
-std::string platform_string(cl_platform_id platform, cl_platform_info what) {
+// A string property through clGet*Info (query size, then text); "?" when the query fails.
+template <typename Object, typename Info>
+std::string info_string(cl_int (*get_info)(Object, Info, std::size_t, void*, std::size_t*), Object object,
+                        Info what) {
   std::size_t size = 0;
-  if (clGetPlatformInfo(platform, what, 0, nullptr, &size) != CL_SUCCESS) return "?";
+  if (get_info(object, what, 0, nullptr, &size) != CL_SUCCESS) return "?";
   std::string text(size, '\0');
-  clGetPlatformInfo(platform, what, size, text.data(), nullptr);
+  get_info(object, what, size, text.data(), nullptr);
   while (!text.empty() && text.back() == '\0') text.pop_back();
   return text;
 }
+std::string platform_string(cl_platform_id platform, cl_platform_info what) {
+  return info_string(clGetPlatformInfo, platform, what);
+}
 std::string device_string(cl_device_id device, cl_device_info what) {
-  std::size_t size = 0;
-  if (clGetDeviceInfo(device, what, 0, nullptr, &size) != CL_SUCCESS) return "?";
-  std::string text(size, '\0');
-  clGetDeviceInfo(device, what, size, text.data(), nullptr);
-  while (!text.empty() && text.back() == '\0') text.pop_back();
-  return text;
+  return info_string(clGetDeviceInfo, device, what);
 }
 template <typename T>
 T device_value(cl_device_id device, cl_device_info what) {

@@ -7,28 +7,40 @@
 
 namespace amytiss_ros {
 
+namespace {
+
+// The one answer behind both GetInput and InputCommand: on success `input` holds the policy's
+// input and `probability` V_k of the state's cell; otherwise `input` is empty, `probability` 0
+// and `message` says why.
+bool answer_state(const amytiss::Policy* policy, const std::vector<double>& state, unsigned time_step,
+                  const std::string& no_policy_reason, std::vector<double>& input, double& probability,
+                  std::string& message) {
+  probability = 0.0;
+  message.clear();
+  if (policy == nullptr) {
+    input.clear();
+    message = "no policy yet: " + no_policy_reason;
+    return false;
+  }
+  input.resize(policy->inputs.dims());
+  double value = 0.0;
+  const amytiss::LookupStatus status = policy->lookup(state.data(), state.size(), time_step, input.data(), &value);
+  if (status != amytiss::LookupStatus::Ok) {
+    input.clear();
+    message = policy->describe(status, state.data(), state.size(), time_step);
+    return false;
+  }
+  probability = value;
+  return true;
+}
+
+}  // namespace
+
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
                              unsigned time_step, const std::string& no_policy_reason,
                              amytiss::GetInput::Response& response) {
-  response.success = false;
-  response.probability = 0.0;
-  response.message.clear();
-  if (policy == nullptr) {
-    response.input.clear();
-    response.message = "no policy yet: " + no_policy_reason;
-    return;
-  }
-  response.input.resize(policy->inputs.dims());
-  double probability = 0.0;
-  const amytiss::LookupStatus status =
-      policy->lookup(state.data(), state.size(), time_step, response.input.data(), &probability);
-  if (status != amytiss::LookupStatus::Ok) {
-    response.input.clear();
-    response.message = policy->describe(status, state.data(), state.size(), time_step);
-    return;
-  }
-  response.success = true;
-  response.probability = probability;
+  response.success = answer_state(policy, state, time_step, no_policy_reason, response.input, response.probability,
+                                  response.message);
 }
 
 void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
@@ -36,25 +48,8 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamp
   command.header.stamp = state.header.stamp;
   command.header.frame_id = state.header.frame_id;
   command.time_step = state.time_step;
-  command.valid = false;
-  command.probability = 0.0;
-  command.message.clear();
-  if (policy == nullptr) {
-    command.input.clear();
-    command.message = "no policy yet: " + no_policy_reason;
-    return;
-  }
-  command.input.resize(policy->inputs.dims());
-  double probability = 0.0;
-  const amytiss::LookupStatus status = policy->lookup(state.state.data(), state.state.size(),
-                                                      state.time_step, command.input.data(), &probability);
-  if (status != amytiss::LookupStatus::Ok) {
-    command.input.clear();
-    command.message = policy->describe(status, state.state.data(), state.state.size(), state.time_step);
-    return;
-  }
-  command.valid = true;
-  command.probability = probability;
+  command.valid = answer_state(policy, state.state, state.time_step, no_policy_reason, command.input,
+                               command.probability, command.message);
 }
 
 amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
@@ -91,41 +86,39 @@ PlaneBox project(const std::vector<double>& lb, const std::vector<double>& ub) {
   return {lb[0], ub[0], two_d ? lb[1] : -0.5, two_d ? ub[1] : 0.5};
 }
 
-visualization_msgs::Marker filled_box(const PlaneBox& box, const std::string& frame_id,
-                                      const std::string& ns, float r, float g, float b) {
+visualization_msgs::Marker colored_marker(const std::string& frame_id, const std::string& ns, int type, float r,
+                                          float g, float b, float a) {
   visualization_msgs::Marker marker;
   marker.header.frame_id = frame_id;
   marker.ns = ns;
   marker.id = 0;
-  marker.type = visualization_msgs::Marker::CUBE;
+  marker.type = type;
   marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.position.x = 0.5 * (box.x_min + box.x_max);
-  marker.pose.position.y = 0.5 * (box.y_min + box.y_max);
   marker.pose.orientation.w = 1.0;
-  marker.scale.x = std::max(box.x_max - box.x_min, 1e-3);
-  marker.scale.y = std::max(box.y_max - box.y_min, 1e-3);
-  marker.scale.z = 0.05;
   marker.color.r = r;
   marker.color.g = g;
   marker.color.b = b;
-  marker.color.a = 0.5f;
+  marker.color.a = a;
+  return marker;
+}
+
+visualization_msgs::Marker filled_box(const PlaneBox& box, const std::string& frame_id,
+                                      const std::string& ns, float r, float g, float b) {
+  visualization_msgs::Marker marker =
+      colored_marker(frame_id, ns, visualization_msgs::Marker::CUBE, r, g, b, 0.5f);
+  marker.pose.position.x = 0.5 * (box.x_min + box.x_max);
+  marker.pose.position.y = 0.5 * (box.y_min + box.y_max);
+  marker.scale.x = std::max(box.x_max - box.x_min, 1e-3);
+  marker.scale.y = std::max(box.y_max - box.y_min, 1e-3);
+  marker.scale.z = 0.05;
   return marker;
 }
 
 visualization_msgs::Marker outline(const PlaneBox& box, const std::string& frame_id,
                                    const std::string& ns, float r, float g, float b) {
-  visualization_msgs::Marker marker;
-  marker.header.frame_id = frame_id;
-  marker.ns = ns;
-  marker.id = 0;
-  marker.type = visualization_msgs::Marker::LINE_STRIP;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.orientation.w = 1.0;
+  visualization_msgs::Marker marker =
+      colored_marker(frame_id, ns, visualization_msgs::Marker::LINE_STRIP, r, g, b, 1.0f);
   marker.scale.x = 0.05;
-  marker.color.r = r;
-  marker.color.g = g;
-  marker.color.b = b;
-  marker.color.a = 1.0f;
   const double corners[5][2] = {{box.x_min, box.y_min}, {box.x_max, box.y_min}, {box.x_max, box.y_max},
                                 {box.x_min, box.y_max}, {box.x_min, box.y_min}};
   for (const auto& corner : corners) {

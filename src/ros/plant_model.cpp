@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "amytiss/errors.hpp"
+#include "amytiss/noise.hpp"
 
 namespace amytiss_ros {
 
@@ -21,20 +21,7 @@ PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
     return;
   }
   // Full covariance: Cholesky factor L (Sigma = L L^T), so L z with z ~ N(0, I) has covariance Sigma.
-  const auto& sigma = noise.covariance;
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j <= i; ++j) {
-      double sum = sigma.at(i * n + j);
-      for (std::size_t k = 0; k < j; ++k) sum -= noise_factor_[i * n + k] * noise_factor_[j * n + k];
-      if (i == j) {
-        if (sum <= 0.0)
-          throw amytiss::ConfigError("noise.covariance", "is not positive definite (plant simulator)");
-        noise_factor_[i * n + i] = std::sqrt(sum);
-      } else {
-        noise_factor_[i * n + j] = sum / noise_factor_[j * n + j];
-      }
-    }
-  }
+  noise_factor_ = amytiss::cholesky_factor(noise.covariance, n);
 }
 
 std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {

@@ -92,18 +92,16 @@ double8 erfc_nonnegative8x2(double8 z, double8 z2, double8* result2) {
   return t * exp(-z * z + 0.5 * (ERFC_COEFFICIENTS[0] + ty * d) - dd);
 }
 
-// Mass of [lo, hi] under the 1-d law with the given mean and scale (normal: standard deviation,
-// uniform: half-width). Scale 0 is a point mass, 1 when lo <= mean < hi (as NoiseModel).
+#if UNIFORM
+// Mass of [lo, hi] under the uniform law with the given mean and half-width `scale` (normal
+// masses come from the shared cell-bound tails in compute_record). Scale 0 is a point mass, 1
+// when lo <= mean < hi (as NoiseModel).
 double interval_mass(double lo, double hi, double mean, double scale) {
   if (scale <= 0.0) return (lo <= mean && mean < hi) ? 1.0 : 0.0;
-#if UNIFORM
   double overlap = fmin(hi, mean + scale) - fmax(lo, mean - scale);
   return overlap > 0.0 ? fmin(1.0, overlap / (2.0 * scale)) : 0.0;
-#else
-  double inverse = 1.0 / (scale * 1.4142135623730951);
-  return 0.5 * (erfc((lo - mean) * inverse) - erfc((hi - mean) * inverse));
-#endif
 }
+#endif
 
 // Transition record of the triple (state, input, disturbance): post mean computed once, window
 // placed in double exactly as Grid::nearest, masses in double rounded to float. Returns the
@@ -250,6 +248,22 @@ double input_value(__global const double* v, uint state, uint local_state, uint 
   return worst;
 }
 
+// max over the inputs first, first + step, ... of input_value(), and in *best_index the lowest
+// input attaining it (left as given when no input beats -1). Pruning against the best of lower
+// inputs keeps the argmax exact.
+double best_over_inputs(__global const double* v, uint state, uint local_state, uint first, uint step,
+                        uint* best_index, __global const uint* starts, __global const float* masses) {
+  double best = -1.0;
+  for (uint input = first; input < N_INPUTS; input += step) {
+    const double value = input_value(v, state, local_state, input, best, starts, masses);
+    if (value > best) {
+      best = value;
+      *best_index = input;
+    }
+  }
+  return best;
+}
+
 // Fixed cells keep their value; returns true when the state is Free.
 bool handle_fixed(uint state, uint offset, __global const uchar* roles, __global double* v_next,
                   __global uint* best_input) {
@@ -271,16 +285,8 @@ __kernel void synthesize_item(__global const double* v, __global double* v_next,
   const uint state = state_begin + local_state;
   const uint offset = padded_offset(state);
   if (!handle_fixed(state, offset, roles, v_next, best_input)) return;
-  double best = -1.0;
   uint best_index = 0;
-  for (uint input = 0; input < N_INPUTS; ++input) {
-    const double value = input_value(v, state, local_state, input, best, starts, masses);
-    if (value > best) {
-      best = value;
-      best_index = input;
-    }
-  }
-  v_next[offset] = best;
+  v_next[offset] = best_over_inputs(v, state, local_state, 0, 1, &best_index, starts, masses);
   best_input[state] = best_index;
 }
 
@@ -303,17 +309,8 @@ void synthesize_group(__global const double* v, __global double* v_next,
     if (lane == 0) handle_fixed(state, offset, roles, v_next, best_input);
     return;  // uniform over the group
   }
-  double best = -1.0;
   uint best_index = 0xffffffffu;
-  for (uint input = lane; input < N_INPUTS; input += GROUP_SIZE) {
-    // Pruning against this lane's best of lower inputs keeps the argmax exact.
-    const double value = input_value(v, state, local_state, input, best, starts, masses);
-    if (value > best) {
-      best = value;
-      best_index = input;
-    }
-  }
-  group_value[lane] = best;
+  group_value[lane] = best_over_inputs(v, state, local_state, lane, GROUP_SIZE, &best_index, starts, masses);
   group_index[lane] = best_index;
   barrier(CLK_LOCAL_MEM_FENCE);
   for (uint stride = GROUP_SIZE / 2; stride > 0; stride /= 2) {

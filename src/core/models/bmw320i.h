@@ -20,13 +20,7 @@
 #ifndef AMYTISS_MODEL_BMW320I_H
 #define AMYTISS_MODEL_BMW320I_H
 
-#ifndef AMYTISS_MODEL_FUNCTION
-#ifdef __OPENCL_VERSION__
-#define AMYTISS_MODEL_FUNCTION
-#else
-#define AMYTISS_MODEL_FUNCTION static inline
-#endif
-#endif
+/* AMYTISS_MODEL_FUNCTION comes from model_function.h, which is put before this header. */
 
 #define BMW320I_TAU 0.1
 #define BMW320I_KINEMATIC_SPEED 0.1

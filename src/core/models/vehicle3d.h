@@ -10,13 +10,7 @@
 #ifndef AMYTISS_MODEL_VEHICLE3D_H
 #define AMYTISS_MODEL_VEHICLE3D_H
 
-#ifndef AMYTISS_MODEL_FUNCTION
-#ifdef __OPENCL_VERSION__
-#define AMYTISS_MODEL_FUNCTION
-#else
-#define AMYTISS_MODEL_FUNCTION static inline
-#endif
-#endif
+/* AMYTISS_MODEL_FUNCTION comes from model_function.h, which is put before this header. */
 
 #define VEHICLE3D_TAU 0.3
 
