@@ -1,5 +1,6 @@
 // The serial reference engine: the paper's Algorithms 1 + 3 written plainly, in double precision.
 // It is the oracle the OpenCL engine is tested against, so clarity wins over speed here.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -159,7 +160,9 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
           best_input = static_cast<std::uint32_t>(u);
         }
       }
-      values[cell] = best_value;
+      // A sum of exact masses is at most 1, but its double rounding may exceed 1 by an ulp or so;
+      // the value is a probability (and the policy file holds it to [0, 1]).
+      values[cell] = std::min(best_value, 1.0);
       chosen[cell] = best_input;
     }
 

@@ -128,10 +128,10 @@ void expect_agreement(const std::string& label, const Abstraction& a,
               report.transitions.c_str());
   EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label;
   EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
-  // Values are probabilities.
+  // Values are probabilities: the policy file refuses anything outside [0, 1].
   for (double value : opencl.values) {
-    ASSERT_GE(value, 0.0);
-    ASSERT_LE(value, 1.0 + 1e-6);
+    ASSERT_GE(value, 0.0) << label;
+    ASSERT_LE(value, 1.0) << label;
   }
 }
 
@@ -295,6 +295,21 @@ TEST(OpenClEngine, ZeroVarianceDimensionAgreesWithReference) {
 
 // Same kernels, four ways: stored/on-the-fly x work-item/work-group, plus a chunked run. The
 // per-(state, input) arithmetic is the same code, so the results must be bit-identical.
+// Float-stored masses of a row can sum to slightly more than 1; next to the target that used to
+// give values of 1 + 1e-8, which the policy file refuses. Coarse vehicle3d is such a case.
+TEST(OpenClEngine, ValuesStayProbabilitiesWhereRoundedRowsSumAboveOne) {
+  Config config = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/vehicle3d.yaml");
+  config.states.eta = {1.0, 1.0, 0.4};
+  config.spec.horizon = 4;
+  const Abstraction a = Abstraction::from_config(config);
+  expect_agreement("vehicle3d coarse", a, TransitionStorage::Stored);
+  SynthesisOptions group_options = cpu_options(TransitionStorage::Stored);
+  OpenClEngineOptions group_engine;
+  group_engine.variant = SweepVariant::GroupPerState;
+  const Policy grouped = detail::synthesize_opencl(a, group_options, nullptr, group_engine);
+  EXPECT_LE(*std::max_element(grouped.values.begin(), grouped.values.end()), 1.0);
+}
+
 TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;

@@ -265,6 +265,11 @@ double best_over_inputs(__global const double* v, uint state, uint local_state, 
 }
 
 // Fixed cells keep their value; returns true when the state is Free.
+// Masses are stored as float: a row's rounded masses may sum to 1 + a few 1e-8 where the exact
+// row sums to at most 1, and so may a value. The exact value is a probability, so the excess is
+// pure rounding (inside the error bound of docs/engine.md) and is removed here, after the argmax.
+double probability_from_sum(double value) { return fmin(value, 1.0); }
+
 bool handle_fixed(uint state, uint offset, __global const uchar* roles, __global double* v_next,
                   __global uint* best_input) {
   const uchar role = roles[state];
@@ -286,7 +291,7 @@ __kernel void synthesize_item(__global const double* v, __global double* v_next,
   const uint offset = padded_offset(state);
   if (!handle_fixed(state, offset, roles, v_next, best_input)) return;
   uint best_index = 0;
-  v_next[offset] = best_over_inputs(v, state, local_state, 0, 1, &best_index, starts, masses);
+  v_next[offset] = probability_from_sum(best_over_inputs(v, state, local_state, 0, 1, &best_index, starts, masses));
   best_input[state] = best_index;
 }
 
@@ -326,7 +331,7 @@ void synthesize_group(__global const double* v, __global double* v_next,
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   if (lane == 0) {
-    v_next[offset] = group_value[0];
+    v_next[offset] = probability_from_sum(group_value[0]);
     best_input[state] = group_index[0];
   }
 }
