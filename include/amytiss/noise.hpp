@@ -50,6 +50,9 @@ class NoiseModel {
 
   /// h_i per dimension (see above); the window has 2*h_i + 1 cells before clipping.
   const std::vector<std::int64_t>& window_half_cells() const { return window_half_cells_; }
+  /// Per dimension: 1 when the window is the whole grid dimension whatever the post mean
+  /// (truncation none, noise present), 0 otherwise.
+  const std::vector<char>& whole_grid_dims() const { return whole_grid_dims_; }
   /// Cells in the unclipped window: product of (2h_i + 1), capped at the grid size.
   std::size_t window_cells() const;
   /// Upper bound of the probability mass a transition loses to truncation (0 for none/uniform).

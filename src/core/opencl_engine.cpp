@@ -324,7 +324,7 @@ std::string int_text(long long value) { return std::to_string(value); }
 
 // Layout numbers of a problem shared by the prelude and the host.
 struct Layout {
-  std::vector<long long> half, width, mass_offset, padded_count, padded_stride;
+  std::vector<long long> half, width, mass_offset, padded_count, padded_stride, whole;
   long long mass_record = 0;
   std::size_t padded_size = 1;
   explicit Layout(const Abstraction& a) {
@@ -335,11 +335,15 @@ struct Layout {
     mass_offset.resize(dims);
     padded_count.resize(dims);
     padded_stride.resize(dims);
+    whole.resize(dims);
     for (std::size_t i = 0; i < dims; ++i) {
       const long long count = static_cast<long long>(a.states.count(i));
-      // The window never needs more than the grid: h <= n - 1 keeps the padding bounded.
-      half[i] = std::min<long long>(h[i], count - 1);
-      width[i] = 2 * half[i] + 1;
+      whole[i] = a.noise->whole_grid_dims()[i] ? 1 : 0;
+      // A whole-grid window is the dimension itself: no padding, n cells from index 0 (padding
+      // by n - 1 on each side would make the value array (3n - 2)^d: 2^28 cells for StocHy 14-d).
+      // Otherwise the window never needs more than the grid: h <= n - 1 bounds the padding.
+      half[i] = whole[i] ? 0 : std::min<long long>(h[i], count - 1);
+      width[i] = whole[i] ? count : 2 * half[i] + 1;
       mass_offset[i] = mass_record;
       mass_record += width[i];
       padded_count[i] = count + 2 * half[i];
@@ -525,6 +529,7 @@ std::string opencl_program_source(const Abstraction& a, bool on_the_fly, std::si
     << constant_array("double", "STATE_ETA", a.states.eta(), real)
     << constant_array("int", "STATE_COUNT", counts_of(a.states), integer)
     << constant_array("int", "HALF_CELLS", layout.half, integer)
+    << constant_array("int", "WHOLE_DIM", layout.whole, integer)
     << constant_array("long", "KEEP_HALF", keep_half, integer)
     << constant_array("int", "WIDTH", layout.width, integer)
     << constant_array("int", "MASS_OFFSET", layout.mass_offset, integer)

@@ -310,6 +310,41 @@ TEST(OpenClEngine, ValuesStayProbabilitiesWhereRoundedRowsSumAboveOne) {
   EXPECT_LE(*std::max_element(grouped.values.begin(), grouped.values.end()), 1.0);
 }
 
+// StocHy's CSB benchmark is n decoupled copies of x+ = 0.8x + noise, autonomous, safety in the
+// grid: the abstraction is a product, so V_0 of the n-d system is V_0 of the 1-d system to the
+// n-th power. With truncation none in 14 dimensions, a value array padded by n - 1 cells per side
+// would need 4^14 cells (2 GiB, refused by pocl); the whole-grid window needs no padding.
+TEST(OpenClEngine, StochyFourteenDimensionsIsTheOneDimensionalValueToThe14th) {
+  constexpr int kDims = 14;
+  // Float masses: the relative error of a product of 14 factors over 6 steps stays far below this.
+  constexpr double kRelativeTolerance = 1e-5;
+  auto stochy = [](int dims) {
+    std::string lb, ub, eta, dynamics, covariance;
+    for (int i = 0; i < dims; ++i) {
+      const std::string comma = i ? ", " : "";
+      lb += comma + "-0.5";
+      ub += comma + "0.5";
+      eta += comma + "1";
+      covariance += comma + "0.2";
+      dynamics += comma + "\"0.8*x" + std::to_string(i) + "\"";
+    }
+    return "name: stochy\nstates: {lb: [" + lb + "], ub: [" + ub + "], eta: [" + eta + "]}\n" +
+           "dynamics: [" + dynamics + "]\n" +
+           "noise: {type: additive, distribution: normal, covariance: [" + covariance +
+           "], truncation: none}\nspec: {type: safety, horizon: 6}\n";
+  };
+  const Policy one = synthesize_reference(from_yaml(stochy(1)), {}, nullptr);
+  const Abstraction fourteen = from_yaml(stochy(kDims));
+  const Policy many = synthesize(fourteen, cpu_options(), nullptr);
+  ASSERT_EQ(many.states.size(), std::size_t(1) << kDims);
+  for (std::size_t cell : {std::size_t(0), std::size_t(5), many.states.size() - 1}) {
+    const std::vector<double> point = many.states.point(cell);
+    double expected = 1.0;
+    for (double coordinate : point) expected *= one.value(0, coordinate < 0 ? 0 : 1);
+    EXPECT_NEAR(many.value(0, cell), expected, kRelativeTolerance * expected) << "cell " << cell;
+  }
+}
+
 TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
@@ -451,7 +486,8 @@ TEST(OpenClEngine, WideLastDimensionWindowUsesTheScalarContractionAndAgrees) {
       "spec: {type: safety, horizon: 3, safe: {lb: [-1, -4], ub: [1, 4]}}\n");
   const std::string wide_source = detail::opencl_program_source(wide, false, 1);
   EXPECT_EQ(wide_source.find("double4 even0"), std::string::npos) << "scalar form expected";
-  EXPECT_NE(wide_source.find("j < 201"), std::string::npos) << "window of 2 * 100 + 1 cells";
+  // Truncation none: the window is the whole dimension, its 101 cells.
+  EXPECT_NE(wide_source.find("j < 101"), std::string::npos) << "window of the 101 cells of x1";
   expect_agreement("wide last dimension (scalar contraction)", wide, TransitionStorage::Stored);
   const std::string robot_source =
       detail::opencl_program_source(from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2)), false, 1);

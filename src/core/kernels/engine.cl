@@ -144,7 +144,8 @@ uint compute_record(ulong state, ulong input, ulong disturbance, float* m) {
     double nearest_real = floor((mean[dim] - STATE_LB[dim]) / eta + 0.5);
     nearest_real = fmax(fmin(nearest_real, (double)(count + keep_half + 1)), (double)(-keep_half - 2));
     const long nearest = finite ? (long)nearest_real : -keep_half - 2;
-    const int start = (int)clamp(nearest, 0L, (long)(count - 1));
+    // A whole-grid dimension's window is the grid itself, from index 0 (HALF_CELLS is 0 there).
+    const int start = WHOLE_DIM[dim] ? 0 : (int)clamp(nearest, 0L, (long)(count - 1));
 #if TRUNCATION_NONE
     keep_first[dim] = 0;
     keep_last[dim] = finite ? count - 1 : -1;
