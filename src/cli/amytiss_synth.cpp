@@ -138,8 +138,10 @@ void print_sizes(const Abstraction& abstraction) {
               abstraction.pairs(), abstraction.triples(), abstraction.horizon);
 }
 
-// Bytes of the policy arrays (as in the file) and of stored transitions: per triple, the first
-// index of the window per dimension (int32) and the per-dimension cell masses (float32).
+// Bytes of the policy arrays (as in the file) and of stored transitions, as the OpenCL engine
+// stores them (docs/engine.md): per triple, the padded offset of the window (uint32) and the
+// per-dimension cell masses (float32) of a window of 2*min(h, n-1)+1 cells, or n for a whole-grid
+// dimension.
 void print_memory_estimate(const Abstraction& abstraction) {
   const double cells = double(abstraction.states.size());
   const double horizon = double(abstraction.horizon);
@@ -147,10 +149,12 @@ void print_memory_estimate(const Abstraction& abstraction) {
                               horizon * cells * sizeof(std::uint32_t) + cells;
   double masses_per_triple = 0;
   const auto& half_cells = abstraction.noise->window_half_cells();
-  for (std::size_t dim = 0; dim < half_cells.size(); ++dim)
-    masses_per_triple += double(std::min<std::int64_t>(2 * half_cells[dim] + 1,
-                                                       std::int64_t(abstraction.states.count(dim))));
-  const double bytes_per_triple = 4.0 * double(abstraction.states.dims()) + 4.0 * masses_per_triple;
+  const auto& whole_grid = abstraction.noise->whole_grid_dims();
+  for (std::size_t dim = 0; dim < half_cells.size(); ++dim) {
+    const auto count = std::int64_t(abstraction.states.count(dim));
+    masses_per_triple += double(whole_grid[dim] ? count : 2 * std::min(half_cells[dim], count - 1) + 1);
+  }
+  const double bytes_per_triple = 4.0 + 4.0 * masses_per_triple;
   std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",
               format_bytes(policy_bytes).c_str(),
               format_bytes(bytes_per_triple * double(abstraction.triples())).c_str(),
