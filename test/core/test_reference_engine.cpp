@@ -81,36 +81,9 @@ TEST(ReferenceEngine, RandomWalkTwoStepsExplicitSum) {
 // transitions[(x * U + u) * W + w][x'] for all cells.
 using TransitionTable = std::vector<std::vector<double>>;
 
-// Independent of the engine's loops: diagonal normal without truncation, erf products.
-TransitionTable erf_transitions(const Abstraction& abstraction) {
-  const Grid& states = abstraction.states;
-  const std::size_t n = states.dims();
-  TransitionTable table;
-  std::vector<double> mean(n);
-  for (std::size_t x = 0; x < states.size(); ++x)
-    for (std::size_t u = 0; u < abstraction.inputs.size(); ++u)
-      for (std::size_t w = 0; w < abstraction.disturbances.size(); ++w) {
-        const auto point = states.point(x), input = abstraction.inputs.point(u),
-                   disturbance = abstraction.disturbances.point(w);
-        abstraction.dynamics->evaluate(point.data(), input.data(), disturbance.data(), mean.data());
-        std::vector<double> row(states.size());
-        for (std::size_t target = 0; target < states.size(); ++target) {
-          const auto center = states.point(target);
-          double probability = 1;
-          for (std::size_t d = 0; d < n; ++d) {
-            const double eta = states.eta()[d];
-            probability *= erf_mass(center[d] - eta / 2, center[d] + eta / 2, mean[d],
-                                    std::sqrt(abstraction.config.noise.covariance[d]));
-          }
-          row[target] = probability;
-        }
-        table.push_back(row);
-      }
-  return table;
-}
-
-// Through the noise model (full covariance, truncation): tests the recursion, not the masses.
-TransitionTable model_transitions(const Abstraction& abstraction) {
+// Every row of the table, in (x, u, w) order: probability(target, mean, current point) per cell.
+template <typename Probability>
+TransitionTable transition_table(const Abstraction& abstraction, const Probability& probability) {
   const Grid& states = abstraction.states;
   TransitionTable table;
   std::vector<double> mean(states.dims());
@@ -122,10 +95,34 @@ TransitionTable model_transitions(const Abstraction& abstraction) {
         abstraction.dynamics->evaluate(point.data(), input.data(), disturbance.data(), mean.data());
         std::vector<double> row(states.size());
         for (std::size_t target = 0; target < states.size(); ++target)
-          row[target] = abstraction.noise->transition_probability(states, target, mean.data(), point.data());
+          row[target] = probability(target, mean, point);
         table.push_back(row);
       }
   return table;
+}
+
+// Independent of the engine's loops: diagonal normal without truncation, erf products.
+TransitionTable erf_transitions(const Abstraction& abstraction) {
+  const Grid& states = abstraction.states;
+  return transition_table(abstraction, [&](std::size_t target, const std::vector<double>& mean,
+                                           const std::vector<double>&) {
+    const auto center = states.point(target);
+    double probability = 1;
+    for (std::size_t d = 0; d < states.dims(); ++d) {
+      const double eta = states.eta()[d];
+      probability *= erf_mass(center[d] - eta / 2, center[d] + eta / 2, mean[d],
+                              std::sqrt(abstraction.config.noise.covariance[d]));
+    }
+    return probability;
+  });
+}
+
+// Through the noise model (full covariance, truncation): tests the recursion, not the masses.
+TransitionTable model_transitions(const Abstraction& abstraction) {
+  return transition_table(abstraction, [&](std::size_t target, const std::vector<double>& mean,
+                                           const std::vector<double>& point) {
+    return abstraction.noise->transition_probability(abstraction.states, target, mean.data(), point.data());
+  });
 }
 
 // V^pi_0 of a Markov policy pi[step][free index] against the worst adversary per step.
