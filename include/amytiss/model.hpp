@@ -1,10 +1,12 @@
 #pragma once
 // The system map f(x, u, w) (the mean of the next state before noise).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/expression.hpp"
 
 namespace amytiss {
 
@@ -22,6 +24,9 @@ class Dynamics {
   virtual std::string opencl_source() const = 0;
   /// A short description for logs, e.g. "expressions (2)" or "built-in bmw320i".
   virtual std::string describe() const = 0;
+  /// For each post coordinate i, the components f_i reads (f_i depends on no other), when known;
+  /// nullopt when the model does not say (every coordinate may read every component).
+  virtual std::optional<std::vector<VariableUse>> dependencies() const { return std::nullopt; }
 };
 
 /// Builds the dynamics of a validated configuration: expressions, or the built-in `model`.

@@ -43,6 +43,12 @@ class ExpressionDynamics : public Dynamics {
 
   std::string describe() const override { return "expressions (" + std::to_string(expressions_.size()) + ")"; }
 
+  std::optional<std::vector<VariableUse>> dependencies() const override {
+    std::vector<VariableUse> uses;
+    for (const Expression& expression : expressions_) uses.push_back(expression.variables());
+    return uses;
+  }
+
  private:
   std::vector<Expression> expressions_;
   std::size_t input_dims_, disturbance_dims_;

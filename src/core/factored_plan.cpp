@@ -1,0 +1,324 @@
+#include "factored_plan.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "opencl_engine.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+// Orders are searched exhaustively up to this many dimensions (8! = 40,320 orders), greedily above.
+constexpr std::size_t kExhaustiveOrderDims = 8;
+// Tensor sizes are indexed with 64-bit integers in the kernels; plans beyond this are refused.
+constexpr double kMaxTensorEntries = 4.0e18;
+
+std::vector<FactorVariable> grid_variables(const Abstraction& a) {
+  std::vector<FactorVariable> variables;
+  for (std::size_t i = 0; i < a.states.dims(); ++i)
+    variables.push_back({FactorVariable::Space::State, i, a.states.count(i)});
+  for (std::size_t i = 0; i < a.inputs.dims(); ++i)
+    variables.push_back({FactorVariable::Space::Input, i, a.inputs.count(i)});
+  for (std::size_t i = 0; i < a.disturbances.dims(); ++i)
+    variables.push_back({FactorVariable::Space::Disturbance, i, a.disturbances.count(i)});
+  return variables;
+}
+
+// Kept cells of a dimension's window at most (the whole dimension for truncation none).
+std::size_t window_width(const Abstraction& a, std::size_t dim) {
+  const std::size_t count = a.states.count(dim);
+  if (a.noise->whole_grid_dims()[dim]) return count;
+  const std::int64_t half = a.noise->window_half_cells()[dim];
+  return std::size_t(std::min<std::int64_t>(2 * half + 1, std::int64_t(count)));
+}
+
+// Entries of W_k for k = 1..d in the order (the sliced dimension, order.back(), at full size),
+// and the multiply-adds of all stages.
+struct OrderCost {
+  std::vector<double> sizes;
+  double multiply_adds = 0;
+};
+
+OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<std::vector<std::size_t>>& reads,
+                     const std::vector<FactorVariable>& variables, const std::vector<std::size_t>& counts,
+                     const std::vector<std::size_t>& widths) {
+  OrderCost cost;
+  std::vector<char> used(variables.size(), 0), remaining(counts.size(), 1);
+  for (std::size_t dim : order) {
+    for (std::size_t v : reads[dim]) used[v] = 1;
+    remaining[dim] = 0;
+    double size = 1;
+    for (std::size_t v = 0; v < variables.size(); ++v)
+      if (used[v]) size *= double(variables[v].count);
+    for (std::size_t r = 0; r < counts.size(); ++r)
+      if (remaining[r]) size *= double(counts[r]);
+    cost.sizes.push_back(size);
+    cost.multiply_adds += size * double(widths[dim]);
+  }
+  return cost;
+}
+
+std::vector<std::size_t> greedy_order(const std::vector<std::vector<std::size_t>>& reads,
+                                      const std::vector<FactorVariable>& variables,
+                                      const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths) {
+  std::vector<std::size_t> order, left(counts.size());
+  std::iota(left.begin(), left.end(), 0);
+  while (!left.empty()) {
+    std::size_t best = 0;
+    double best_cost = INFINITY;
+    for (std::size_t j = 0; j < left.size(); ++j) {
+      std::vector<std::size_t> trial = order;
+      trial.push_back(left[j]);
+      const double cost = order_cost(trial, reads, variables, counts, widths).multiply_adds;
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = j;
+      }
+    }
+    order.push_back(left[best]);
+    left.erase(left.begin() + std::ptrdiff_t(best));
+  }
+  return order;
+}
+
+std::vector<std::uint64_t> strides_of(const std::vector<TensorDigit>& layout) {
+  std::vector<std::uint64_t> strides(layout.size());
+  std::uint64_t stride = 1;
+  for (std::size_t j = layout.size(); j-- > 0;) {
+    strides[j] = stride;
+    stride *= layout[j].radix;
+  }
+  return strides;
+}
+
+std::uint64_t stride_in(const std::vector<TensorDigit>& layout, const std::vector<std::uint64_t>& strides,
+                        bool post, std::size_t id) {
+  for (std::size_t j = 0; j < layout.size(); ++j)
+    if (layout[j].post == post && layout[j].id == id) return strides[j];
+  return 0;
+}
+
+// Stages of an order for slices of `slice_cells` cells of the last dimension eliminated.
+std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
+                                        const std::vector<std::vector<std::size_t>>& reads,
+                                        const std::vector<FactorVariable>& variables,
+                                        const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths,
+                                        std::size_t slice_cells) {
+  const std::size_t dims = counts.size(), sliced = order.back();
+  std::vector<TensorDigit> input;
+  for (std::size_t r = 0; r < dims; ++r) input.push_back({true, r, counts[r]});  // V, unsliced
+  std::vector<char> used(variables.size(), 0), remaining(dims, 1);
+  std::vector<FactoredStage> stages;
+  for (std::size_t dim : order) {
+    for (std::size_t v : reads[dim]) used[v] = 1;
+    remaining[dim] = 0;
+    FactoredStage stage;
+    stage.dimension = dim;
+    stage.width = widths[dim];
+    for (std::size_t v = 0; v < variables.size(); ++v)
+      if (used[v]) stage.output.push_back({false, v, variables[v].count});
+    for (std::size_t r = 0; r < dims; ++r)
+      if (remaining[r]) stage.output.push_back({true, r, r == sliced ? slice_cells : counts[r]});
+    const std::vector<std::uint64_t> input_strides = strides_of(input);
+    std::vector<std::uint64_t> tuple_strides(variables.size(), 0);
+    std::uint64_t tuple_stride = 1;
+    for (std::size_t j = reads[dim].size(); j-- > 0;) {
+      tuple_strides[reads[dim][j]] = tuple_stride;
+      tuple_stride *= variables[reads[dim][j]].count;
+    }
+    stage.output_size = 1;
+    for (const TensorDigit& digit : stage.output) {
+      stage.output_size *= digit.radix;
+      stage.input_stride.push_back(stride_in(input, input_strides, digit.post, digit.id));
+      stage.tuple_stride.push_back(digit.post ? 0 : tuple_strides[digit.id]);
+    }
+    stage.contracted_stride = stride_in(input, input_strides, true, dim);
+    input = stage.output;
+    stages.push_back(std::move(stage));
+  }
+  return stages;
+}
+
+std::string variable_name(const FactorVariable& variable) {
+  const char* prefix = variable.space == FactorVariable::Space::State   ? "x"
+                       : variable.space == FactorVariable::Space::Input ? "u"
+                                                                         : "w";
+  return prefix + std::to_string(variable.index);
+}
+
+}  // namespace
+
+std::string FactoredPlan::describe() const {
+  std::string text = "factored sweep: eliminates";
+  for (std::size_t dim : order) text += " x'" + std::to_string(dim);
+  char numbers[200];
+  std::snprintf(numbers, sizeof numbers,
+                "; %.3g multiply-adds per step against %.3g for the dense sweep (%.1fx fewer); %zu slice%s; "
+                "%.0f MiB",
+                multiply_adds, dense_multiply_adds, dense_multiply_adds / std::max(multiply_adds, 1.0), slices,
+                slices == 1 ? "" : "s", double(device_bytes) / 1048576.0);
+  text += numbers;
+  text += "; reads:";
+  for (std::size_t dim = 0; dim < reads.size(); ++dim) {
+    text += " x'" + std::to_string(dim) + "(";
+    for (std::size_t j = 0; j < reads[dim].size(); ++j) text += (j ? "," : "") + variable_name(variables[reads[dim][j]]);
+    text += ")";
+  }
+  return text;
+}
+
+std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double budget_bytes, std::string* reason) {
+  auto refuse = [&](const std::string& why) -> std::optional<FactoredPlan> {
+    if (reason) *reason = why;
+    return std::nullopt;
+  };
+  if (!a.noise->separable()) return refuse("the noise is not separable (full covariance)");
+  const auto dependencies = a.dynamics->dependencies();
+  if (!dependencies) return refuse("the dynamics (" + a.dynamics->describe() + ") do not say which components each coordinate reads");
+
+  FactoredPlan plan;
+  plan.variables = grid_variables(a);
+  const std::size_t dims = a.states.dims(), inputs_base = dims, disturbances_base = dims + a.inputs.dims();
+  std::vector<std::size_t> counts(dims), widths(dims);
+  for (std::size_t dim = 0; dim < dims; ++dim) {
+    counts[dim] = a.states.count(dim);
+    widths[dim] = window_width(a, dim);
+    const VariableUse& use = (*dependencies)[dim];
+    std::vector<std::size_t> reads;
+    for (std::size_t i : use.states) reads.push_back(i);
+    if (a.noise->type() == NoiseType::Multiplicative) reads.push_back(dim);  // the scale is |x_dim|
+    for (std::size_t i : use.inputs) reads.push_back(inputs_base + i);
+    for (std::size_t i : use.disturbances) reads.push_back(disturbances_base + i);
+    std::sort(reads.begin(), reads.end());
+    reads.erase(std::unique(reads.begin(), reads.end()), reads.end());
+    plan.reads.push_back(std::move(reads));
+  }
+
+  // The cheapest order; among equally cheap ones, the one with the smallest tensors.
+  std::vector<std::size_t> best_order;
+  OrderCost best_cost;
+  auto consider = [&](const std::vector<std::size_t>& order) {
+    OrderCost cost = order_cost(order, plan.reads, plan.variables, counts, widths);
+    const double largest = *std::max_element(cost.sizes.begin(), cost.sizes.end());
+    const double best_largest =
+        best_order.empty() ? INFINITY : *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end());
+    if (best_order.empty() || cost.multiply_adds < best_cost.multiply_adds ||
+        (cost.multiply_adds == best_cost.multiply_adds && largest < best_largest)) {
+      best_order = order;
+      best_cost = std::move(cost);
+    }
+  };
+  if (dims <= kExhaustiveOrderDims) {
+    std::vector<std::size_t> order(dims);
+    std::iota(order.begin(), order.end(), 0);
+    do consider(order);
+    while (std::next_permutation(order.begin(), order.end()));
+  } else {
+    consider(greedy_order(plan.reads, plan.variables, counts, widths));
+  }
+  if (*std::max_element(best_cost.sizes.begin(), best_cost.sizes.end()) > kMaxTensorEntries)
+    return refuse("its tensors would exceed 64-bit indexing");
+
+  plan.order = best_order;
+  plan.multiply_adds = best_cost.multiply_adds;
+  plan.dense_multiply_adds = double(a.states.size()) * double(a.inputs.size()) * double(a.disturbances.size()) *
+                             contraction_multiply_adds(a);
+  plan.q_size = std::uint64_t(best_cost.sizes.back());
+
+  double table_bytes = 0;
+  for (std::size_t dim = 0; dim < dims; ++dim) {
+    double tuples = 1;
+    for (std::size_t v : plan.reads[dim]) tuples *= double(plan.variables[v].count);
+    table_bytes += tuples * (double(widths[dim]) * sizeof(double) + 2 * sizeof(std::uint32_t));
+  }
+  const double fixed_bytes = double(sizeof(double)) * (2.0 * double(a.states.size()) + double(plan.q_size)) +
+                             double(a.states.size()) * (1 + sizeof(std::uint32_t)) + table_bytes;
+  // Stage tensors W_1..W_{d-1} hold the sliced dimension's cells: they shrink with the slice.
+  const double largest_stage =
+      dims > 1 ? *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end() - 1) : 0.0;
+  const std::size_t sliced_count = counts[plan.order.back()];
+  plan.slices = 0;
+  for (std::size_t slices = 1; slices <= sliced_count; ++slices) {
+    if (sliced_count % slices) continue;
+    if (dims == 1 && slices > 1) break;  // a single stage reads V itself: nothing to slice
+    const double bytes = fixed_bytes + 2.0 * sizeof(double) * largest_stage / double(slices);
+    if (bytes <= budget_bytes) {
+      plan.slices = slices;
+      plan.device_bytes = std::size_t(bytes);
+      break;
+    }
+  }
+  if (plan.slices == 0) {
+    char text[160];
+    std::snprintf(text, sizeof text, "its tensors need more than the budget of %.0f MiB even in slices",
+                  budget_bytes / 1048576.0);
+    return refuse(text);
+  }
+  plan.slice_cells = sliced_count / plan.slices;
+  plan.stages = build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells);
+  for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
+    plan.largest_stage_tensor = std::max(plan.largest_stage_tensor, plan.stages[k].output_size);
+  const FactoredStage& last = plan.stages.back();
+  assert(last.output_size == plan.q_size);
+  plan.q_stride.assign(plan.variables.size(), 0);
+  const std::vector<std::uint64_t> q_strides = strides_of(last.output);
+  for (std::size_t j = 0; j < last.output.size(); ++j) plan.q_stride[last.output[j].id] = q_strides[j];
+  return plan;
+}
+
+std::vector<MassTable> factored_mass_tables(const Abstraction& a, const FactoredPlan& plan) {
+  const std::size_t dims = a.states.dims();
+  std::vector<double> x(dims), u(std::max<std::size_t>(1, a.inputs.dims())),
+      w(std::max<std::size_t>(1, a.disturbances.dims())), post(dims);
+  auto component = [&](const FactorVariable& variable) -> double& {
+    switch (variable.space) {
+      case FactorVariable::Space::State: return x[variable.index];
+      case FactorVariable::Space::Input: return u[variable.index];
+      default: return w[variable.index];
+    }
+  };
+  auto coordinate = [&](const FactorVariable& variable, std::size_t k) {
+    switch (variable.space) {
+      case FactorVariable::Space::State: return a.states.coordinate(variable.index, k);
+      case FactorVariable::Space::Input: return a.inputs.coordinate(variable.index, k);
+      default: return a.disturbances.coordinate(variable.index, k);
+    }
+  };
+  std::vector<MassTable> tables(dims);
+  for (std::size_t dim = 0; dim < dims; ++dim) {
+    MassTable& table = tables[dim];
+    table.variables = plan.reads[dim];
+    table.width = plan.stages[std::size_t(std::find(plan.order.begin(), plan.order.end(), dim) - plan.order.begin())].width;
+    // Components f_dim does not read keep their first grid value: the post coordinate is the same.
+    for (const FactorVariable& variable : plan.variables) component(variable) = coordinate(variable, 0);
+    std::size_t tuples = 1;
+    for (std::size_t v : table.variables) tuples *= plan.variables[v].count;
+    table.first.assign(tuples, 0);
+    table.count.assign(tuples, 0);
+    table.masses.assign(tuples * table.width, 0.0);
+    std::vector<std::size_t> digit(table.variables.size(), 0);
+    for (std::size_t tuple = 0; tuple < tuples; ++tuple) {
+      for (std::size_t j = 0; j < digit.size(); ++j)
+        component(plan.variables[table.variables[j]]) = coordinate(plan.variables[table.variables[j]], digit[j]);
+      a.dynamics->evaluate(x.data(), u.data(), w.data(), post.data());
+      std::int64_t first = 0, last = -1;
+      if (a.noise->dimension_window(a.states, dim, post[dim], &first, &last)) {
+        assert(std::size_t(last - first + 1) <= table.width);
+        table.first[tuple] = std::uint32_t(first);
+        table.count[tuple] = std::uint32_t(last - first + 1);
+        a.noise->cell_masses(dim, first, last, post[dim], a.noise->scale(dim, x.data()),
+                             &table.masses[tuple * table.width]);
+      }
+      for (std::size_t j = digit.size(); j-- > 0;) {  // next tuple, the last digit fastest
+        if (++digit[j] < plan.variables[table.variables[j]].count) break;
+        digit[j] = 0;
+      }
+    }
+  }
+  return tables;
+}
+
+}  // namespace amytiss::detail
