@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/expression.hpp"
 
 namespace amytiss {
 
@@ -27,6 +28,10 @@ class Dynamics {
 /// Builds the dynamics of a validated configuration: expressions, or the built-in `model`.
 /// Throws ConfigError (key "dynamics[i]" with the parse column, or "model").
 std::unique_ptr<Dynamics> make_dynamics(const Config& config);
+/// The dynamics expressions of `config` parsed, one per state dimension: the one place they are
+/// parsed (Config::validate() and make_dynamics() both call it). Throws ConfigError naming
+/// dynamics[i] with the parser's message.
+std::vector<Expression> parse_dynamics(const Config& config);
 
 /// Names of the built-in models ("bmw320i", "vehicle3d") and their dimensions.
 struct BuiltinModelInfo {

@@ -4,6 +4,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/expression.hpp"
+#include "embedded_sources.hpp"
 
 namespace amytiss {
 namespace builtin {
@@ -12,10 +13,6 @@ namespace builtin {
 #include "models/bmw320i.h"
 #include "models/vehicle3d.h"
 }  // namespace builtin
-
-namespace detail {
-const char* embedded_source(const std::string& name);
-}
 
 namespace {
 
@@ -116,8 +113,15 @@ std::unique_ptr<Dynamics> make_dynamics(const Config& config) {
   if (config.dynamics.size() != n)
     throw ConfigError("dynamics", "got " + std::to_string(config.dynamics.size()) + " expressions, expected " +
                                       std::to_string(n) + ", one per state dimension");
+  return std::make_unique<ExpressionDynamics>(parse_dynamics(config), m, p);
+}
+
+std::vector<Expression> parse_dynamics(const Config& config) {
+  const std::size_t n = config.states.lb.size();
+  const std::size_t m = config.inputs ? config.inputs->lb.size() : 0;
+  const std::size_t p = config.disturbances ? config.disturbances->lb.size() : 0;
   std::vector<Expression> expressions;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < config.dynamics.size(); ++i) {
     try {
       expressions.push_back(Expression::parse(config.dynamics[i], config.constants, n, m, p));
     } catch (const ParseError& error) {
@@ -125,7 +129,7 @@ std::unique_ptr<Dynamics> make_dynamics(const Config& config) {
                         std::string(error.what()) + " in \"" + config.dynamics[i] + "\"");
     }
   }
-  return std::make_unique<ExpressionDynamics>(std::move(expressions), m, p);
+  return expressions;
 }
 
 }  // namespace amytiss

@@ -274,8 +274,8 @@ double probability_from_sum(double value) { return fmin(value, 1.0); }
 bool handle_fixed(uint state, uint offset, __global const uchar* roles, __global double* v_next,
                   __global uint* best_input) {
   const uchar role = roles[state];
-  if (role == 0) return true;
-  v_next[offset] = role == 2 ? 1.0 : 0.0;
+  if (role == ROLE_FREE) return true;
+  v_next[offset] = role == ROLE_FIXED_ONE ? 1.0 : 0.0;
   best_input[state] = 0;
   return false;
 }
@@ -311,7 +311,7 @@ void synthesize_group(__global const double* v, __global double* v_next,
   if (local_state >= state_count) return;  // uniform over the group
   const uint state = state_begin + local_state;
   const uint offset = padded_offset(state);
-  if (roles[state] != 0) {
+  if (roles[state] != ROLE_FREE) {
     if (lane == 0) handle_fixed(state, offset, roles, v_next, best_input);
     return;  // uniform over the group
   }
