@@ -29,7 +29,7 @@ constexpr const char* kUsage =
     "an HDF5 policy file (docs/policy_file.md).\n"
     "\n"
     "options:\n"
-    "  --config FILE                      YAML configuration (SPEC section 3)\n"
+    "  --config FILE                      YAML configuration (docs/configuration.md)\n"
     "  --device auto|cpu|gpu|reference    overrides compute.device\n"
     "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"

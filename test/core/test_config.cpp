@@ -1,4 +1,4 @@
-// Configuration: the YAML schema, every bad input of SPEC section 7, the canonical text and the hash.
+// Configuration: the YAML schema, every bad input that validate() refuses (docs/configuration.md), the canonical text and the hash.
 #include <cmath>
 #include <fstream>
 #include <string>

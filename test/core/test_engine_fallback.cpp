@@ -1,4 +1,4 @@
-// SPEC section 7: a failing device falls back to the CPU device with a warning.
+// A failing device falls back to the CPU device with a warning note (docs/engine.md).
 #include <gtest/gtest.h>
 
 #include <string>

@@ -18,7 +18,7 @@ using test_support::uniform_noise;
 
 constexpr double kQuadratureTolerance = 1e-12;     // absolute, 1-d cell masses vs quadrature
 constexpr double kTailRelativeTolerance = 1e-9;    // relative, masses far in the tails
-constexpr double kRowSumSlack = 1e-6;              // SPEC: rows sum to at most 1 + 1e-6
+constexpr double kRowSumSlack = 1e-6;              // rows sum to at most 1 + 1e-6 (docs/engine.md, precision)
 constexpr double kRoundingSlack = 1e-12;
 constexpr double kQuantileRelativeTolerance = 1e-12;
 

@@ -534,7 +534,7 @@ TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
 }
 
 TEST(OpenClEngine, RobotReachAvoidFullGridAgreesWithReference) {
-  // SPEC section 5's grid: 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
+  // The robot reach-avoid example's grid (config/robot_reach_avoid.yaml): 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
   // 16 only to keep the serial reference under ~10 s here; the T_d = 16 comparison is recorded in
   // docs/engine.md (max |dV| 2.2e-7).
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(0.5, 0.1, 6));
