@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "amytiss/abstraction.hpp"
+#include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
 #include "config_from_params.hpp"
@@ -36,7 +37,7 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
                      [this](const amytiss::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
   status_publisher_ = public_handle_.advertise<amytiss::PolicyStatus>("status", 1, /*latch=*/true);
   update_status([](amytiss::PolicyStatus& status) {
-    status.phase = "idle";
+    status.phase = amytiss::PolicyStatus::PHASE_IDLE;
     status.remaining_s = -1;
     status.message = "synthesizer started";
   });
@@ -95,7 +96,7 @@ SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<am
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
     update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "error";
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
@@ -114,7 +115,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     outcome.message = std::string("bad policy_file parameter: ") + error.what();
     ROS_ERROR("%s", outcome.message.c_str());
     update_status([&](amytiss::PolicyStatus& status) {
-      status.phase = "error";
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
@@ -133,7 +134,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       status.policy_file = outcome.policy_file;
       status.horizon = horizon;
       status.generation += 1;
-      if (phase == "done") status.syntheses_run += 1;
+      if (phase == amytiss::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
     });
   };
 
@@ -145,7 +146,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name +
                         "' unchanged, hash " + hash + "); nothing to synthesize";
       ROS_INFO("%s", outcome.message.c_str());
-      announce(loaded.policy.horizon, "reused", loaded.policy.computed_by);
+      announce(loaded.policy.horizon, amytiss::PolicyStatus::PHASE_REUSED, loaded.policy.computed_by);
       return outcome;
     } catch (const amytiss::PolicyFileError& error) {
       ROS_INFO("not reusing %s: %s", outcome.policy_file.c_str(), error.what());
@@ -157,7 +158,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
   update_status([&](amytiss::PolicyStatus& status) {
     status.synthesizing = true;
     status.percent = 0.0;
-    status.phase = "setup";
+    status.phase = amytiss::PolicyStatus::PHASE_SETUP;
     status.device = device;
     status.remaining_s = -1;
     status.message = "synthesizing '" + config.name + "' on " + device;
@@ -173,7 +174,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       update_status([&](amytiss::PolicyStatus& status) {
         status.synthesizing = true;
         status.percent = progress.percent();
-        status.phase = progress.phase;
+        status.phase = amytiss::to_string(progress.phase);
         status.device = progress.device;
         status.remaining_s = progress.remaining_s;
         status.message = text;
@@ -183,12 +184,11 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     };
     amytiss::SynthesisReport report;
     const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
-    for (const auto& note : report.log) {
-      // Device fallbacks are warnings (SPEC section 7); the other notes (storage, memory) are facts.
-      if (note.find("fall") != std::string::npos || note.find("no OpenCL") != std::string::npos)
-        ROS_WARN("%s", note.c_str());
+    for (const auto& note : report.notes) {
+      if (note.severity == amytiss::NoteSeverity::Warning)
+        ROS_WARN("%s", note.text.c_str());
       else
-        ROS_INFO("%s", note.c_str());
+        ROS_INFO("%s", note.text.c_str());
     }
     if (cancelled()) throw amytiss::Cancelled();
     std::filesystem::create_directories(std::filesystem::path(outcome.policy_file).parent_path());
@@ -204,13 +204,13 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     outcome.success = true;
     outcome.message = text;
     ROS_INFO("%s", text);
-    announce(policy.horizon, "done", policy.computed_by);
+    announce(policy.horizon, amytiss::PolicyStatus::PHASE_DONE, policy.computed_by);
   } catch (const amytiss::Cancelled&) {
     outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
     ROS_WARN("%s", outcome.message.c_str());
     update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "cancelled";
+      status.phase = amytiss::PolicyStatus::PHASE_CANCELLED;
       status.remaining_s = -1;
       status.message = outcome.message;
     });
@@ -219,7 +219,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
     update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "error";
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.remaining_s = -1;
       status.message = outcome.message;
     });

@@ -5,7 +5,7 @@
 //   action  synthesize (amytiss/Synthesize): re-read the private parameters (or the goal's YAML)
 //           and synthesize; cancel the goal to stop; feedback per time step.
 //   topic   status (amytiss/PolicyStatus, latched): progress, errors, and each new policy.
-// Private parameters: the configuration schema (SPEC section 3), plus
+// Private parameters: the configuration schema (docs/configuration.md), plus
 //   ~policy_file (string, default $ROS_HOME/amytiss/<name>.h5, ROS_HOME defaults to ~/.ros),
 //   ~device (string, overrides compute.device when not empty: auto | cpu | gpu | reference),
 //   ~synthesize_on_start (bool, default true).

@@ -215,7 +215,7 @@ TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerializa
 
 TEST(ProgressConversions, FeedbackCarriesEveryField) {
   amytiss::Progress progress;
-  progress.phase = "synthesis";
+  progress.phase = amytiss::Phase::Synthesis;
   progress.steps_done = 7;
   progress.steps_total = 16;
   progress.device = "reference";
@@ -302,4 +302,20 @@ TEST(Outcomes, ClassifyByCellRole) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
+}
+
+// The engine's phase names are the message constants, in PolicyStatus and in the action feedback.
+TEST(ProgressConversions, PhaseNamesAreTheMessageConstants) {
+  const std::pair<amytiss::Phase, std::string> status_phases[] = {
+      {amytiss::Phase::Setup, amytiss::PolicyStatus::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss::PolicyStatus::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss::PolicyStatus::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss::PolicyStatus::PHASE_DONE}};
+  for (const auto& [phase, name] : status_phases) EXPECT_EQ(amytiss::to_string(phase), name);
+  const std::pair<amytiss::Phase, std::string> feedback_phases[] = {
+      {amytiss::Phase::Setup, amytiss::SynthesizeFeedback::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss::SynthesizeFeedback::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss::SynthesizeFeedback::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss::SynthesizeFeedback::PHASE_DONE}};
+  for (const auto& [phase, name] : feedback_phases) EXPECT_EQ(amytiss::to_string(phase), name);
 }
