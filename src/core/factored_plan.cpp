@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <numeric>
 
-#include "opencl_engine.hpp"
+#include "opencl_layout.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -170,7 +170,8 @@ std::string FactoredPlan::describe() const {
   return text;
 }
 
-std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double budget_bytes, std::string* reason) {
+std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double budget_bytes, double max_buffer_bytes,
+                                                std::string* reason) {
   auto refuse = [&](const std::string& why) -> std::optional<FactoredPlan> {
     if (reason) *reason = why;
     return std::nullopt;
@@ -245,7 +246,9 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
     if (sliced_count % slices) continue;
     if (dims == 1 && slices > 1) break;  // a single stage reads V itself: nothing to slice
     const double bytes = fixed_bytes + 2.0 * sizeof(double) * largest_stage / double(slices);
-    if (bytes <= budget_bytes) {
+    const double largest_buffer =
+        sizeof(double) * std::max({largest_stage / double(slices), double(plan.q_size), double(a.states.size())});
+    if (bytes <= budget_bytes && largest_buffer <= max_buffer_bytes) {
       plan.slices = slices;
       plan.device_bytes = std::size_t(bytes);
       break;
@@ -253,8 +256,9 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
   }
   if (plan.slices == 0) {
     char text[160];
-    std::snprintf(text, sizeof text, "its tensors need more than the budget of %.0f MiB even in slices",
-                  budget_bytes / 1048576.0);
+    std::snprintf(text, sizeof text,
+                  "its tensors need more than the budget of %.0f MiB (or buffers above %.0f MiB) even in slices",
+                  budget_bytes / 1048576.0, max_buffer_bytes / 1048576.0);
     return refuse(text);
   }
   plan.slice_cells = sliced_count / plan.slices;

@@ -70,10 +70,11 @@ struct FactoredPlan {
   std::string describe() const;
 };
 
-/// The cheapest elimination order whose tensors fit `budget_bytes`, or nullopt with the reason
-/// (dynamics without dependency information, non-separable noise, nothing fits).
+/// The cheapest elimination order whose buffers fit `budget_bytes` in all and `max_buffer_bytes`
+/// each, or nullopt with the reason (dynamics without dependency information, non-separable
+/// noise, nothing fits).
 std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& abstraction, double budget_bytes,
-                                                std::string* reason);
+                                                double max_buffer_bytes, std::string* reason);
 
 /// Kept masses of one post dimension for every tuple of the variables it reads.
 struct MassTable {

@@ -58,6 +58,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   Kernel choose(clCreateKernel(program.get(), "choose_inputs", &error));
   check(error, "clCreateKernel(choose_inputs)");
   report.phases.push_back({"kernel build", seconds_since(phase_start), 0, 0});
+  if (run.progress) run.progress(Phase::Setup, 0, -1);
 
   // --- construction: the kept masses of every dimension, once
   phase_start = Clock::now();
@@ -89,7 +90,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   report.notes.push_back({NoteSeverity::Info, NoteKind::DeviceMemory,
                           "device memory: " + std::to_string(device_bytes / 1048576) + " MiB"});
   const double construction_seconds = seconds_since(phase_start);
-  report.phases.push_back({"construction (mass tables)", construction_seconds,
+  report.phases.push_back({"construction", construction_seconds,
                            double(a.pairs()) / std::max(construction_seconds, 1e-9), 0});
   if (run.progress) run.progress(Phase::Construction, 0, -1);
 

@@ -19,6 +19,7 @@
 #include "amytiss/errors.hpp"
 #include "opencl_engine.hpp"
 #include "opencl_source.hpp"
+#include "agreement.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -38,64 +39,11 @@ Abstraction from_yaml(const std::string& text) {
   return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
 }
 
-// Expected next value of (state, input) under V_{step+1} of `policy`, min over disturbances,
-// evaluated directly in double from the noise model (independent of both engines' loops).
-double input_value(const Abstraction& a, const Policy& policy, unsigned step, std::size_t state,
-                   std::size_t input) {
-  const std::size_t dims = a.states.dims();
-  const std::vector<double> x = a.states.point(state), u = a.inputs.point(input);
-  const double* next = &policy.values[std::size_t(step + 1) * a.states.size()];
-  double worst = std::numeric_limits<double>::infinity();
-  for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
-    const std::vector<double> disturbance = a.disturbances.point(w);
-    std::vector<double> mean(dims);
-    a.dynamics->evaluate(x.data(), u.data(), disturbance.data(), mean.data());
-    std::vector<std::int64_t> first(dims), last(dims);
-    double expected = 0.0;
-    if (a.noise->window(a.states, mean.data(), first.data(), last.data())) {
-      std::vector<std::size_t> multi(dims);
-      for (std::size_t d = 0; d < dims; ++d) multi[d] = std::size_t(first[d]);
-      while (true) {
-        double probability = 1.0;
-        for (std::size_t d = 0; d < dims; ++d)
-          probability *= a.noise->cell_mass(d, multi[d], mean[d], a.noise->scale(d, x.data()));
-        expected += probability * next[a.states.flat_index(multi.data())];
-        std::size_t d = dims;
-        while (d-- > 0) {
-          if (std::int64_t(++multi[d]) <= last[d]) break;
-          multi[d] = std::size_t(first[d]);
-        }
-        if (d == std::size_t(-1)) break;
-      }
-    }
-    worst = std::min(worst, expected);
-  }
-  return worst;
-}
-
-struct Agreement {
-  double max_value_difference = 0;
-  std::size_t input_mismatches = 0;       // cells whose chosen inputs differ
-  double max_mismatch_margin = 0;         // largest q(reference input) - q(opencl input) there
-};
-
-Agreement compare(const Abstraction& a, const Policy& reference, const Policy& opencl) {
-  Agreement result;
-  EXPECT_EQ(reference.values.size(), opencl.values.size());
-  EXPECT_EQ(reference.input_index.size(), opencl.input_index.size());
-  for (std::size_t i = 0; i < reference.values.size(); ++i)
-    result.max_value_difference =
-        std::max(result.max_value_difference, std::fabs(reference.values[i] - opencl.values[i]));
-  for (unsigned step = 0; step < a.horizon; ++step)
-    for (std::size_t cell = 0; cell < a.states.size(); ++cell) {
-      const auto chosen_reference = reference.input(step, cell), chosen_opencl = opencl.input(step, cell);
-      if (chosen_reference == chosen_opencl) continue;
-      ++result.input_mismatches;
-      const double margin = input_value(a, reference, step, cell, chosen_reference) -
-                            input_value(a, reference, step, cell, chosen_opencl);
-      result.max_mismatch_margin = std::max(result.max_mismatch_margin, margin);
-    }
-  return result;
+// The dense sweep whatever the dynamics (the engine's choice may be the factored sweep).
+OpenClEngineOptions dense() {
+  OpenClEngineOptions engine;
+  engine.decomposition = detail::SweepDecomposition::Dense;
+  return engine;
 }
 
 SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::Auto) {
@@ -112,28 +60,33 @@ double seconds_of(const SynthesisReport& report) {
   return total;
 }
 
-// Runs both engines, checks the contract, prints the figures.
+// Runs the reference, the dense sweep and the engine's own choice (the factored sweep where the
+// dynamics allow it), checks the contract for both, prints the figures.
 void expect_agreement(const std::string& label, const Abstraction& a,
                       TransitionStorage transitions = TransitionStorage::Auto) {
   const auto reference_start = std::chrono::steady_clock::now();
   const Policy reference = synthesize_reference(a, {}, nullptr);
   const double reference_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - reference_start).count();
-  SynthesisReport report;
-  const Policy opencl = synthesize(a, cpu_options(transitions), &report);
-  const Agreement agreement = compare(a, reference, opencl);
-  std::printf("[%s] pairs %zu, max |dV| %.3g, input mismatches %zu (max margin %.3g), reference %.3f s, "
-              "opencl %.3f s (%s)\n",
-              label.c_str(), a.pairs(), agreement.max_value_difference, agreement.input_mismatches,
-              agreement.max_mismatch_margin, reference_seconds, seconds_of(report),
-              report.transitions.c_str());
-  EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label;
-  EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
-  // Values are probabilities: the policy file refuses anything outside [0, 1].
-  for (double value : opencl.values) {
-    ASSERT_GE(value, 0.0) << label;
-    ASSERT_LE(value, 1.0) << label;
-  }
+  SynthesisReport dense_report, auto_report;
+  const Policy dense_policy = detail::synthesize_opencl(a, cpu_options(transitions), &dense_report, dense());
+  const Policy chosen = synthesize(a, cpu_options(transitions), &auto_report);
+  auto check = [&](const char* name, const Policy& opencl, const SynthesisReport& report) {
+    const Agreement agreement = compare(a, reference, opencl);
+    std::printf("[%s, %s] pairs %zu, max |dV| %.3g, input mismatches %zu (max margin %.3g), reference %.3f s, "
+                "opencl %.3f s (%s)\n",
+                label.c_str(), name, a.pairs(), agreement.max_value_difference, agreement.input_mismatches,
+                agreement.max_mismatch_margin, reference_seconds, seconds_of(report), report.transitions.c_str());
+    EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label << ", " << name;
+    EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label << ", " << name;
+    // Values are probabilities: the policy file refuses anything outside [0, 1].
+    for (double value : opencl.values) {
+      ASSERT_GE(value, 0.0) << label;
+      ASSERT_LE(value, 1.0) << label;
+    }
+  };
+  check("dense", dense_policy, dense_report);
+  check("auto", chosen, auto_report);
 }
 
 std::string robot_reach_avoid_yaml(double state_eta, double input_eta, unsigned horizon) {
@@ -350,7 +303,7 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
   const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
-                                                  {SweepVariant::ItemPerState, 0, {}});
+                                                  {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 0, {}});
   EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
   struct Variant {
     const char* name;
@@ -358,11 +311,11 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     OpenClEngineOptions engine;
   };
   const Variant variants[] = {
-      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}}},
-      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}}},
-      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}}},
-      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}}},
-      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}}},
+      {"on the fly, item", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 0, {}}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 0, {}}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 0, {}}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 37, {}}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 50, {}}},
   };
   for (const Variant& variant : variants) {
     SynthesisReport report;
@@ -387,10 +340,10 @@ TEST(OpenClEngine, AutoTransitionsFallsBackToOnTheFlyWhenStoredDoesNotFit) {
   SynthesisOptions options = cpu_options(TransitionStorage::Auto);
   options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
   SynthesisReport report;
-  const Policy small_budget = synthesize(a, options, &report);
+  const Policy small_budget = detail::synthesize_opencl(a, options, &report, dense());
   EXPECT_EQ(report.transitions.rfind("on_the_fly (auto", 0), 0u) << report.transitions;
   SynthesisReport stored_report;
-  const Policy stored = synthesize(a, cpu_options(TransitionStorage::Auto), &stored_report);
+  const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Auto), &stored_report, dense());
   EXPECT_EQ(stored_report.transitions.rfind("stored (auto", 0), 0u) << stored_report.transitions;
   EXPECT_EQ(small_budget.values, stored.values);
 }
@@ -405,7 +358,7 @@ TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
     return true;
   };
   SynthesisReport report;
-  const Policy policy = synthesize(a, options, &report);
+  const Policy policy = detail::synthesize_opencl(a, options, &report, dense());
   std::vector<std::string> names;
   for (const auto& phase : report.phases) names.push_back(phase.name);
   const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0"};
