@@ -50,6 +50,9 @@ struct FactoredStage {
   std::uint64_t contracted_stride = 0;       ///< input stride of the contracted post cell
   std::uint64_t output_size = 0;             ///< entries of the output tensor (one slice)
   std::size_t width = 0;                     ///< largest number of kept cells of `dimension`
+  /// Output digit whose entries are computed several at a time: input stride 1 (contiguous
+  /// values), tuple stride 0 (shared masses). None: one entry per work-item.
+  std::optional<std::size_t> vector_digit;
 };
 
 struct FactoredPlan {

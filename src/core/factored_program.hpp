@@ -11,8 +11,27 @@
 
 namespace amytiss::detail {
 
+/// Cells after the end of every value and stage tensor buffer: a vector stage's last chunk of a
+/// row may read that far past it.
+constexpr std::size_t kTensorSlack = 8;
+
+/// How a stage with a vector digit maps to work-items. SIMD devices (CPUs: native double vector
+/// width > 1) take a row of the vector digit per work-item in explicit vectors; SIMT devices
+/// (GPUs: width 1) one entry per work-item with the vector digit fastest, so that neighbouring
+/// work-items read neighbouring values. Same sums in the same order either way.
+struct StageShape {
+  bool row_per_item = true;
+  /// Entries per vector: 8, 4 or 2 by the digit's radix for rows, 1 for entries.
+  std::uint64_t lanes(std::uint64_t radix) const;
+};
+StageShape stage_shape_for(unsigned native_double_width);
+
+/// Work-items of a stage's launch.
+std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& shape);
+
 /// OpenCL C of the plan: kernels stage0..stage{d-1} (one elimination each) and choose_inputs.
-std::string factored_program_source(const Abstraction& abstraction, const FactoredPlan& plan);
+std::string factored_program_source(const Abstraction& abstraction, const FactoredPlan& plan,
+                                    const StageShape& shape);
 
 /// What the factored run needs of the engine around it: an open device, and how to report.
 struct FactoredRunContext {

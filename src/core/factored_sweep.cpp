@@ -48,8 +48,13 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
 
   // --- kernel build
   auto phase_start = Clock::now();
-  Program program = build_program(run.context, *run.device, factored_program_source(a, plan), run.kernel_cache_dir,
-                                  report.notes);
+  const StageShape shape = stage_shape_for(run.device->native_double_width);
+  report.notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                          std::string("factored stages: ") +
+                              (shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
+                                                  : "one entry per work-item, neighbours contiguous (SIMT device)")});
+  Program program = build_program(run.context, *run.device, factored_program_source(a, plan, shape),
+                                  run.kernel_cache_dir, report.notes);
   std::vector<Kernel> stage_kernels;
   for (std::size_t k = 0; k < plan.stages.size(); ++k) {
     stage_kernels.emplace_back(clCreateKernel(program.get(), ("stage" + std::to_string(k)).c_str(), &error));
@@ -77,15 +82,16 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
     terminal[x] = a.terminal_value(a.roles[x]);
   }
   Buffer roles_buffer = make_buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n_states, roles.data());
+  terminal.resize(n_states + kTensorSlack, 0.0);
   Buffer values[2] = {
-      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, n_states * sizeof(double), terminal.data()),
-      make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(double), nullptr)};
+      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data()),
+      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data())};
   Buffer best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
   Buffer q = make_buffer(CL_MEM_READ_WRITE, plan.q_size * sizeof(double), nullptr);
   Buffer stage_tensors[2];
   if (plan.stages.size() > 1)
     for (Buffer& tensor : stage_tensors)
-      tensor = make_buffer(CL_MEM_READ_WRITE, plan.largest_stage_tensor * sizeof(double), nullptr);
+      tensor = make_buffer(CL_MEM_READ_WRITE, (plan.largest_stage_tensor + kTensorSlack) * sizeof(double), nullptr);
   report.device_bytes = device_bytes;
   report.notes.push_back({NoteSeverity::Info, NoteKind::DeviceMemory,
                           "device memory: " + std::to_string(device_bytes / 1048576) + " MiB"});
@@ -125,7 +131,8 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   policy.config_hash = config_hash(a.config);
   policy.values.assign((std::size_t(a.horizon) + 1) * n_states, 0.0);
   policy.input_index.assign(std::size_t(a.horizon) * n_states, 0);
-  std::copy(terminal.begin(), terminal.end(), policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
+  std::copy(terminal.begin(), terminal.begin() + std::ptrdiff_t(n_states),
+            policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
 
   const std::size_t last_stage = plan.stages.size() - 1;
   // V's stride of the sliced dimension (row-major over the state grid).
@@ -158,7 +165,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
         check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &lo), "clSetKernelArg");
         check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &hi), "clSetKernelArg");
         check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &accumulate), "clSetKernelArg");
-        launch(kernel, stage.output_size, k);
+        launch(kernel, stage_work_items(stage, shape), k);
       }
     }
     cl_kernel kernel = choose.get();

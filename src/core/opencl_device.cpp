@@ -106,6 +106,8 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.compute_units = device_value<cl_uint>(ids[d], CL_DEVICE_MAX_COMPUTE_UNITS);
       info.max_work_group = device_value<std::size_t>(ids[d], CL_DEVICE_MAX_WORK_GROUP_SIZE);
       info.fp64 = device_string(ids[d], CL_DEVICE_EXTENSIONS).find("cl_khr_fp64") != std::string::npos;
+      info.native_double_width = device_value<cl_uint>(ids[d], CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE);
+      info.max_clock_mhz = device_value<cl_uint>(ids[d], CL_DEVICE_MAX_CLOCK_FREQUENCY);
       devices.push_back(info);
     }
   }
