@@ -187,11 +187,24 @@ std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
     FactoredStage stage;
     stage.dimension = dim;
     stage.width = widths[dim];
-    for (std::size_t v = 0; v < variables.size(); ++v)
-      if (used[v]) stage.output.push_back({false, v, variables[v].count});
-    for (std::size_t r = 0; r < dims; ++r)
-      if (remaining[r]) stage.output.push_back({true, r, r == sliced ? slice_cells : counts[r]});
-    // The next stage's vector digit goes last.
+    // Layout: the input's digits in the input's order (so that work-items stream the input), then
+    // the variables new to this stage (neighbouring work-items then differ in masses only and
+    // re-read the same window of values from cache), then the next stage's contracted cell and
+    // vector digit.
+    for (const TensorDigit& digit : input)
+      if (!(digit.post && digit.id == dim))
+        stage.output.push_back({digit.post, digit.id, digit.post && digit.id == sliced ? slice_cells : digit.radix});
+    for (std::size_t v : reads[dim])
+      if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
+        stage.output.push_back({false, v, variables[v].count});
+    // The next stage's contracted cell goes just before its vector digit: each work-item's
+    // window is then one contiguous block of the next input.
+    if (k + 1 < order.size()) {
+      const auto next = std::find_if(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
+        return digit.post && digit.id == order[k + 1];
+      });
+      std::rotate(next, next + 1, stage.output.end());
+    }
     if (k + 1 < order.size() && vectors[k + 1]) {
       const auto next = std::find_if(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
         return digit.post == vectors[k + 1]->post && digit.id == vectors[k + 1]->id;

@@ -101,11 +101,18 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   if (run.progress) run.progress(Phase::Construction, 0, -1);
 
   std::vector<double> stage_seconds(plan.stages.size() + 1, 0.0), stage_macs(plan.stages.size() + 1, 0.0);
-  double multiply_adds_per_step = 0;
+  // Operand bytes: a value (double) per multiply-add, an entry stored per output; the input
+  // choice loads Q and stores a value and an input per state.
+  std::vector<double> stage_bytes(plan.stages.size() + 1, 0.0);
+  double multiply_adds_per_step = 0, bytes_per_step = 0;
   for (std::size_t k = 0; k < plan.stages.size(); ++k) {
     stage_macs[k] = stage_multiply_adds(plan.stages[k], tables[plan.stages[k].dimension], plan.slices);
+    stage_bytes[k] = 8.0 * (stage_macs[k] + double(plan.stages[k].output_size) * double(plan.slices));
     multiply_adds_per_step += stage_macs[k];
+    bytes_per_step += stage_bytes[k];
   }
+  stage_bytes.back() = 8.0 * double(plan.q_size) + 12.0 * double(n_states);
+  bytes_per_step += stage_bytes.back();
   const std::size_t group = std::min(kGroupSize, std::max<std::size_t>(1, run.device->max_work_group));
   auto launch = [&](cl_kernel kernel, std::size_t entries, std::size_t timing_slot) {
     const auto launch_start = Clock::now();
@@ -184,7 +191,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
     current = 1 - current;
     const double seconds = seconds_since(phase_start);
     report.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
-                             multiply_adds_per_step});
+                             multiply_adds_per_step, bytes_per_step});
     const unsigned done = a.horizon - step;
     if (run.progress)
       run.progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done,
@@ -196,8 +203,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
                                    ? "stage " + std::to_string(k) + " (x'" + std::to_string(plan.stages[k].dimension) +
                                          ", all steps)"
                                    : "input choice (all steps)";
-      const double macs = stage_macs[k] * a.horizon;
-      report.phases.push_back({name, stage_seconds[k], 0, macs});
+      report.phases.push_back({name, stage_seconds[k], 0, stage_macs[k] * a.horizon, stage_bytes[k] * a.horizon, true});
     }
   }
   return policy;

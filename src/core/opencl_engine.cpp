@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "amytiss/errors.hpp"
+#include "device_peak.hpp"
 #include "factored_program.hpp"
 #include "opencl_device.hpp"
 #include "opencl_layout.hpp"
@@ -49,16 +50,16 @@ void check_dense_supported(const Layout& layout) {
 // The factored plan when the decomposition asks for it or it saves enough work; a Sweep note
 // says which sweep runs and why.
 std::optional<FactoredPlan> choose_factored(const Abstraction& a, const DeviceInfo& device,
-                                            const SynthesisOptions& options, SweepDecomposition decomposition,
-                                            SynthesisReport& rep) {
-  if (decomposition == SweepDecomposition::Dense) {
+                                            const SynthesisOptions& options, SynthesisReport& rep) {
+  const SweepChoice decomposition = options.compute.sweep;
+  if (decomposition == SweepChoice::Dense) {
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, "dense sweep (requested)"});
     return std::nullopt;
   }
   std::string reason;
   const double budget = options.compute.memory_fraction * double(device.global_memory);
   std::optional<FactoredPlan> plan = plan_factored_sweep(a, budget, double(device.max_allocation), &reason);
-  if (decomposition == SweepDecomposition::Factored) {
+  if (decomposition == SweepChoice::Factored) {
     if (!plan) throw DeviceError("the factored sweep was requested but cannot run: " + reason);
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, plan->describe() + " (requested)"});
     return plan;
@@ -116,6 +117,10 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   auto phase_start = Clock::now();
   const DeviceInfo device = choose_device(options.compute, rep.notes);
   rep.device = device.label();
+  const DevicePeak peak = double_fma_peak(device.is_gpu(), device.is_cpu(), device.label(), device.compute_units,
+                                          device.max_clock_mhz, device.native_double_width);
+  rep.peak_multiply_adds_per_second = peak.multiply_adds_per_second;
+  rep.peak_basis = peak.basis;
   DeviceSession session = open_session(device);
   rep.phases.push_back({"device setup", seconds_since(phase_start), 0, 0});
 
@@ -124,7 +129,7 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
       throw Cancelled();
   };
 
-  if (const auto factored = choose_factored(a, device, options, engine_options.decomposition, rep)) {
+  if (const auto factored = choose_factored(a, device, options, rep)) {
     rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
     FactoredRunContext run{&device, session.context.get(), session.queue.get(), engine_options.kernel_cache_dir,
                            options.profile, report_progress};
@@ -161,6 +166,11 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   std::vector<double> step_values(layout.padded_size);
   const double multiply_adds_per_step =
       double(buffers.free_states) * double(plan.records_per_state) * contraction_multiply_adds(a);
+  // Each multiply-add loads a double of V; stored records are streamed once per step; each state
+  // stores its value and input.
+  const double record_bytes_per_step =
+      plan.on_the_fly ? 0.0 : double(buffers.free_states) * double(plan.records_per_state) * double(layout.record_bytes());
+  const double bytes_per_step = 8.0 * multiply_adds_per_step + record_bytes_per_step + 12.0 * double(a.states.size());
   const auto synthesis_start = Clock::now();
   int current = 0;
   for (unsigned step = a.horizon; step-- > 0;) {
@@ -171,7 +181,7 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
     const double seconds = seconds_since(phase_start);
     unpad(policy, step, buffers.padded_index, step_values.data());
     rep.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
-                          multiply_adds_per_step});
+                          multiply_adds_per_step, bytes_per_step});
     const unsigned done = a.horizon - step;
     const double remaining = seconds_since(synthesis_start) / done * (a.horizon - done);
     report_progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done, remaining);

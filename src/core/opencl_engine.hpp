@@ -20,16 +20,8 @@ enum class SweepVariant {
   GroupPerState  ///< one work-group per state, work-items over inputs, local argmax (GPU)
 };
 
-/// Which sweep computes the expected next values (docs/engine.md, "Factored sweep").
-enum class SweepDecomposition {
-  Auto,      ///< factored where the dynamics' dependencies make it at least twice cheaper, else dense
-  Dense,     ///< every (state, input, disturbance) contracts its whole window (engine.cl)
-  Factored   ///< variable elimination along the dependencies (factored_plan.hpp); DeviceError if impossible
-};
-
 struct OpenClEngineOptions {
-  SweepDecomposition decomposition = SweepDecomposition::Auto;
-  SweepVariant variant = SweepVariant::Auto;  ///< of the dense sweep
+  SweepVariant variant = SweepVariant::Auto;  ///< of the dense sweep (compute.sweep chooses the sweep)
   /// Upper bound of states per chunk (stored buffers and launches); 0: chosen from device limits.
   std::size_t max_states_per_chunk = 0;
   /// Folder of the program binary cache; empty: $XDG_CACHE_HOME/amytiss/kernels or

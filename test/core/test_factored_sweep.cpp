@@ -20,8 +20,6 @@ namespace amytiss {
 namespace {
 
 using detail::FactoredPlan;
-using detail::OpenClEngineOptions;
-using detail::SweepDecomposition;
 
 // Both engines sum the same exact products in another order: double rounding only.
 constexpr double kValueTolerance = 1e-9;
@@ -76,14 +74,12 @@ SynthesisOptions cpu_options() {
   return options;
 }
 
-Policy run(const Abstraction& a, SweepDecomposition decomposition, SynthesisReport* report = nullptr,
-           double memory_fraction = 0.5) {
+Policy run(const Abstraction& a, SweepChoice sweep, SynthesisReport* report = nullptr, double memory_fraction = 0.5) {
   SynthesisOptions options = cpu_options();
   options.compute.memory_fraction = memory_fraction;
-  OpenClEngineOptions engine;
-  engine.decomposition = decomposition;
+  options.compute.sweep = sweep;
   SynthesisReport local;
-  return detail::synthesize_opencl(a, options, report ? report : &local, engine);
+  return detail::synthesize_opencl(a, options, report ? report : &local);
 }
 
 double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
@@ -188,8 +184,8 @@ TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
 void expect_factored_agrees(const std::string& label, const Abstraction& a) {
   const Policy reference = synthesize_reference(a, {}, nullptr);
   SynthesisReport factored_report, dense_report;
-  const Policy factored = run(a, SweepDecomposition::Factored, &factored_report);
-  const Policy dense = run(a, SweepDecomposition::Dense, &dense_report);
+  const Policy factored = run(a, SweepChoice::Factored, &factored_report);
+  const Policy dense = run(a, SweepChoice::Dense, &dense_report);
   EXPECT_TRUE(has_note(factored_report, "factored sweep")) << label;
   EXPECT_FALSE(has_note(dense_report, "factored sweep: eliminates")) << label;
   const double against_reference = max_difference(reference.values, factored.values);
@@ -222,7 +218,7 @@ TEST(FactoredSweep, MultiplicativeNoiseAgreesWithReferenceAndDense) {
 TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
   const Abstraction a = from_yaml(traffic_yaml(0.4, 3));
   SynthesisReport whole_report, sliced_report;
-  const Policy whole = run(a, SweepDecomposition::Factored, &whole_report);
+  const Policy whole = run(a, SweepChoice::Factored, &whole_report);
   std::string reason;
   const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
   ASSERT_TRUE(plan) << reason;
@@ -230,7 +226,7 @@ TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
   std::vector<EngineNote> notes;
   const double global_memory = double(detail::choose_device(cpu_options().compute, notes).global_memory);
   ASSERT_GT(global_memory, 0.0);
-  const Policy sliced = run(a, SweepDecomposition::Factored, &sliced_report,
+  const Policy sliced = run(a, SweepChoice::Factored, &sliced_report,
                             (double(plan->device_bytes) * 0.6) / global_memory);
   EXPECT_TRUE(has_note(sliced_report, "slices")) << "expected a sliced plan";
   EXPECT_LE(max_difference(whole.values, sliced.values), kValueTolerance);
@@ -239,10 +235,10 @@ TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
 
 TEST(FactoredSweep, AutoChoosesFactoredWhereItSavesWorkAndDenseOtherwise) {
   SynthesisReport traffic_report, lambda_report;
-  run(from_yaml(traffic_yaml(0.4, 1)), SweepDecomposition::Auto, &traffic_report);
+  run(from_yaml(traffic_yaml(0.4, 1)), SweepChoice::Auto, &traffic_report);
   EXPECT_TRUE(has_note(traffic_report, "factored sweep: eliminates"));
   using namespace test_support;
-  run(random_affine_abstraction(5, 2, 1, false, safety_spec(2)), SweepDecomposition::Auto, &lambda_report);
+  run(random_affine_abstraction(5, 2, 1, false, safety_spec(2)), SweepChoice::Auto, &lambda_report);
   EXPECT_TRUE(has_note(lambda_report, "dense sweep"));
   EXPECT_TRUE(has_note(lambda_report, "do not say which components"));
 }
@@ -256,10 +252,9 @@ TEST(FactoredSweep, ReportsPhasesStagesAndProgress) {
     seen.push_back(progress.phase);
     return true;
   };
-  OpenClEngineOptions engine;
-  engine.decomposition = SweepDecomposition::Factored;
+  options.compute.sweep = SweepChoice::Factored;
   SynthesisReport report;
-  detail::synthesize_opencl(a, options, &report, engine);
+  detail::synthesize_opencl(a, options, &report);
   std::vector<std::string> names;
   double stage_multiply_adds = 0, step_multiply_adds = 0;
   for (const auto& phase : report.phases) {

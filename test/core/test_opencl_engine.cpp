@@ -39,13 +39,6 @@ Abstraction from_yaml(const std::string& text) {
   return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
 }
 
-// The dense sweep whatever the dynamics (the engine's choice may be the factored sweep).
-OpenClEngineOptions dense() {
-  OpenClEngineOptions engine;
-  engine.decomposition = detail::SweepDecomposition::Dense;
-  return engine;
-}
-
 SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::Auto) {
   SynthesisOptions options;
   options.compute.device = DeviceKind::Cpu;
@@ -53,10 +46,17 @@ SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::
   return options;
 }
 
+// The dense sweep whatever the dynamics (the engine's choice may be the factored sweep).
+SynthesisOptions dense_options(TransitionStorage transitions = TransitionStorage::Auto) {
+  SynthesisOptions options = cpu_options(transitions);
+  options.compute.sweep = SweepChoice::Dense;
+  return options;
+}
+
 double seconds_of(const SynthesisReport& report) {
   double total = 0;
   for (const auto& phase : report.phases)
-    if (phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
+    if (!phase.breakdown && phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
   return total;
 }
 
@@ -69,7 +69,7 @@ void expect_agreement(const std::string& label, const Abstraction& a,
   const double reference_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - reference_start).count();
   SynthesisReport dense_report, auto_report;
-  const Policy dense_policy = detail::synthesize_opencl(a, cpu_options(transitions), &dense_report, dense());
+  const Policy dense_policy = detail::synthesize_opencl(a, dense_options(transitions), &dense_report);
   const Policy chosen = synthesize(a, cpu_options(transitions), &auto_report);
   auto check = [&](const char* name, const Policy& opencl, const SynthesisReport& report) {
     const Agreement agreement = compare(a, reference, opencl);
@@ -303,7 +303,7 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
   const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
-                                                  {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 0, {}});
+                                                  {SweepVariant::ItemPerState, 0, {}});
   EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
   struct Variant {
     const char* name;
@@ -311,11 +311,11 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     OpenClEngineOptions engine;
   };
   const Variant variants[] = {
-      {"on the fly, item", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 0, {}}},
-      {"stored, group (GPU path)", TransitionStorage::Stored, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 0, {}}},
-      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 0, {}}},
-      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {detail::SweepDecomposition::Dense, SweepVariant::ItemPerState, 37, {}}},
-      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {detail::SweepDecomposition::Dense, SweepVariant::GroupPerState, 50, {}}},
+      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}}},
   };
   for (const Variant& variant : variants) {
     SynthesisReport report;
@@ -340,25 +340,41 @@ TEST(OpenClEngine, AutoTransitionsFallsBackToOnTheFlyWhenStoredDoesNotFit) {
   SynthesisOptions options = cpu_options(TransitionStorage::Auto);
   options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
   SynthesisReport report;
-  const Policy small_budget = detail::synthesize_opencl(a, options, &report, dense());
+  options.compute.sweep = SweepChoice::Dense;
+  const Policy small_budget = detail::synthesize_opencl(a, options, &report);
   EXPECT_EQ(report.transitions.rfind("on_the_fly (auto", 0), 0u) << report.transitions;
   SynthesisReport stored_report;
-  const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Auto), &stored_report, dense());
+  const Policy stored = detail::synthesize_opencl(a, dense_options(TransitionStorage::Auto), &stored_report);
   EXPECT_EQ(stored_report.transitions.rfind("stored (auto", 0), 0u) << stored_report.transitions;
   EXPECT_EQ(small_budget.values, stored.values);
+}
+
+TEST(OpenClEngine, StoredRequestThatDoesNotFitIsRefusedNotReplaced) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
+  SynthesisOptions options = dense_options(TransitionStorage::Stored);
+  options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
+  try {
+    detail::synthesize_opencl(a, options, nullptr);
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    EXPECT_NE(std::string(error.what()).find("compute.transitions stored was requested"), std::string::npos)
+        << error.what();
+  }
+  // Not retried elsewhere either: the request is the user's.
+  EXPECT_THROW(synthesize(a, options), DeviceError);
 }
 
 TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 3));
   std::vector<Progress> seen;
-  SynthesisOptions options = cpu_options(TransitionStorage::Stored);
+  SynthesisOptions options = dense_options(TransitionStorage::Stored);
   options.profile = true;
   options.progress = [&](const Progress& progress) {
     seen.push_back(progress);
     return true;
   };
   SynthesisReport report;
-  const Policy policy = detail::synthesize_opencl(a, options, &report, dense());
+  const Policy policy = detail::synthesize_opencl(a, options, &report);
   std::vector<std::string> names;
   for (const auto& phase : report.phases) names.push_back(phase.name);
   const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0"};
@@ -404,22 +420,28 @@ TEST(OpenClEngine, FullCovarianceIsRefusedClearly) {
   }
 }
 
-TEST(OpenClEngine, GpuRequestWithoutGpuFallsBackWithWarning) {
+TEST(OpenClEngine, ExplicitRequestForAnAbsentDeviceKindFailsNamingTheDevicesPresent) {
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
-  const bool has_gpu = [] {
-    for (const auto& line : list_opencl_devices())
-      if (line.find("(GPU") != std::string::npos) return true;
-    return false;
-  }();
-  if (has_gpu) GTEST_SKIP() << "a GPU is present; the fallback cannot be observed";
+  const auto devices = list_opencl_devices();
+  auto present = [&](const char* type) {
+    return std::any_of(devices.begin(), devices.end(),
+                       [&](const std::string& line) { return line.find(std::string("(") + type) != std::string::npos; });
+  };
+  // CI has only pocl (no GPU); the GPU machine has no CPU device.
+  if (present("GPU") && present("CPU")) GTEST_SKIP() << "both kinds present: no absent kind to request";
+  const bool ask_gpu = !present("GPU");
   SynthesisOptions options = cpu_options();
-  options.compute.device = DeviceKind::Gpu;
-  SynthesisReport report;
-  synthesize(a, options, &report);
-  EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(), [](const EngineNote& note) {
-    return note.severity == NoteSeverity::Warning && note.kind == NoteKind::DeviceFallback &&
-           note.text.find("no OpenCL GPU") != std::string::npos;
-  }));
+  options.compute.device = ask_gpu ? DeviceKind::Gpu : DeviceKind::Cpu;
+  try {
+    synthesize(a, options);
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(std::string("compute.device ") + (ask_gpu ? "gpu" : "cpu") + " was requested"),
+              std::string::npos) << message;
+    EXPECT_NE(message.find("devices present"), std::string::npos) << message;
+    EXPECT_NE(message.find(devices.front().substr(devices.front().find("] ") + 2, 20)), std::string::npos) << message;
+  }
 }
 
 TEST(OpenClEngine, UnknownDeviceSelectionIsADeviceError) {
