@@ -187,9 +187,9 @@ void print_phase_times(const SynthesisReport& report) {
 // Every kernel finishes before its phase's clock stops (profile), so the rates are the device's.
 void print_profile(const SynthesisReport& report) {
   const double peak = report.peak_multiply_adds_per_second;
-  std::printf("profile (%s; double multiply-add peak %s: %s):\n", report.device.c_str(),
-              peak > 0 ? (std::to_string(int(peak / 1e9 + 0.5)) + " GMAC/s").c_str() : "unknown",
-              report.peak_basis.c_str());
+  std::printf("profile (%s):\n", report.device.c_str());
+  if (peak > 0)
+    std::printf("  double multiply-add peak %.0f GMAC/s: %s\n", peak / 1e9, report.peak_basis.c_str());
   std::printf("  %-28s %10s %14s %14s %9s %7s %11s\n", "phase", "seconds", "pairs/s", "multiply-adds", "GMAC/s",
               "% peak", "GB/s (ops)");
   auto print_row = [&](const std::string& name, double seconds, double pairs_per_second, double multiply_adds,

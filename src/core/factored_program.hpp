@@ -39,6 +39,7 @@ struct FactoredRunContext {
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   std::string kernel_cache_dir;  ///< see build_program
+  bool entry_per_item = false;   ///< the SIMT shape whatever the device (tests)
   bool profile = false;          ///< finish every kernel before its clock stops
   /// Called after construction and after each time step (phase, steps done, seconds left or -1);
   /// throws Cancelled to stop.

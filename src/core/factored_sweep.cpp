@@ -8,6 +8,7 @@
 
 #include "amytiss/errors.hpp"
 #include "factored_program.hpp"
+#include "factored_tables.hpp"
 #include "opencl_program_cache.hpp"
 
 namespace amytiss::detail {
@@ -48,7 +49,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
 
   // --- kernel build
   auto phase_start = Clock::now();
-  const StageShape shape = stage_shape_for(run.device->native_double_width);
+  const StageShape shape = stage_shape_for(run.entry_per_item ? 1 : run.device->native_double_width);
   report.notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
                           std::string("factored stages: ") +
                               (shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"

@@ -131,8 +131,10 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
 
   if (const auto factored = choose_factored(a, device, options, rep)) {
     rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
-    FactoredRunContext run{&device, session.context.get(), session.queue.get(), engine_options.kernel_cache_dir,
-                           options.profile, report_progress};
+    FactoredRunContext run{&device,          session.context.get(),
+                           session.queue.get(), engine_options.kernel_cache_dir,
+                           engine_options.factored_entry_per_item, options.profile,
+                           report_progress};
     Policy policy = run_factored_sweep(a, *factored, run, rep);
     rep.host_peak_bytes = peak_resident_bytes();
     return policy;

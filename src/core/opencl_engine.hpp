@@ -27,6 +27,8 @@ struct OpenClEngineOptions {
   /// Folder of the program binary cache; empty: $XDG_CACHE_HOME/amytiss/kernels or
   /// ~/.cache/amytiss/kernels; "-": no cache (always build from source).
   std::string kernel_cache_dir;
+  /// Factored sweep: one entry per work-item (the GPU shape) even on a SIMD device (tests).
+  bool factored_entry_per_item = false;
 };
 
 /// The OpenCL engine (device chosen by options.compute, see synthesize()).

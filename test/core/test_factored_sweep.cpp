@@ -11,6 +11,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "factored_plan.hpp"
+#include "factored_tables.hpp"
 #include "opencl_device.hpp"
 #include "opencl_engine.hpp"
 #include "agreement.hpp"
@@ -213,6 +214,23 @@ TEST(FactoredSweep, RobotWithDisturbanceAgreesWithReferenceAndDense) {
 
 TEST(FactoredSweep, MultiplicativeNoiseAgreesWithReferenceAndDense) {
   expect_factored_agrees("multiplicative 3-d", from_yaml(multiplicative_yaml()));
+}
+
+TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
+  for (const std::string& yaml : {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml()}) {
+    const Abstraction a = from_yaml(yaml);
+    SynthesisOptions options = cpu_options();
+    options.compute.sweep = SweepChoice::Factored;
+    SynthesisReport rows_report, entries_report;
+    const Policy rows = detail::synthesize_opencl(a, options, &rows_report);
+    detail::OpenClEngineOptions entries_engine;
+    entries_engine.factored_entry_per_item = true;
+    const Policy entries = detail::synthesize_opencl(a, options, &entries_report, entries_engine);
+    EXPECT_TRUE(has_note(rows_report, "a row of entries per work-item"));
+    EXPECT_TRUE(has_note(entries_report, "one entry per work-item"));
+    EXPECT_EQ(rows.values, entries.values) << a.config.name;
+    EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name;
+  }
 }
 
 TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {

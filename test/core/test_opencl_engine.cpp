@@ -302,8 +302,8 @@ TEST(OpenClEngine, StochyFourteenDimensionsIsTheOneDimensionalValueToThe14th) {
 TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
-  const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
-                                                  {SweepVariant::ItemPerState, 0, {}});
+  const Policy stored = detail::synthesize_opencl(a, dense_options(TransitionStorage::Stored), &stored_report,
+                                                  {SweepVariant::ItemPerState, 0, {}, false});
   EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
   struct Variant {
     const char* name;
@@ -311,15 +311,15 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     OpenClEngineOptions engine;
   };
   const Variant variants[] = {
-      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}}},
-      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}}},
-      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}}},
-      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}}},
-      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}}},
+      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}, false}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}, false}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}, false}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}, false}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}, false}},
   };
   for (const Variant& variant : variants) {
     SynthesisReport report;
-    const Policy other = detail::synthesize_opencl(a, cpu_options(variant.transitions), &report, variant.engine);
+    const Policy other = detail::synthesize_opencl(a, dense_options(variant.transitions), &report, variant.engine);
     EXPECT_EQ(other.values, stored.values) << variant.name;
     EXPECT_EQ(other.input_index, stored.input_index) << variant.name;
     const bool group = variant.engine.variant == SweepVariant::GroupPerState;
