@@ -25,7 +25,7 @@ struct GridSpec {
 };
 
 enum class NoiseType { Additive, Multiplicative };
-enum class Distribution { Normal, Uniform };
+enum class Distribution { Normal, Uniform, Exponential, Beta, Custom };
 enum class Truncation { None, FixedRegion, CuttingProbability };
 
 struct NoiseConfig {
@@ -36,6 +36,20 @@ struct NoiseConfig {
   std::vector<double> covariance;
   /// uniform: half-width of the support per dimension (noise uniform on [-h, h]).
   std::vector<double> half_width;
+  /// exponential: noise_i = shift_i + Exp(rate_i); rate in 1/state units (> 0), shift in state
+  /// units (empty: 0).
+  std::vector<double> rate;
+  std::vector<double> shift;
+  /// beta: noise_i = support.lb_i + (support.ub_i - support.lb_i) * Beta(alpha_i, beta_i), alpha,
+  /// beta > 0 (dimensionless).
+  std::vector<double> alpha;
+  std::vector<double> beta;
+  /// custom: the density of noise_i as an expression of the variable z (state units), one per
+  /// dimension, in the whitelisted expression grammar; it must be >= 0 and integrate to 1 over
+  /// `support`.
+  std::vector<std::string> density;
+  /// beta and custom: the interval [lb_i, ub_i] the noise lives in (state units, lb < ub).
+  std::optional<Box> support;
   Truncation truncation = Truncation::None;  ///< default: nothing cut (exact)
   /// cutting_probability: total probability mass that may be cut per transition, in (0, 1).
   double cutting_probability = 1e-3;

@@ -13,7 +13,7 @@
 //   unary   := ('-' | '+' | '!') unary | power
 //   power   := atom ( '^' unary )?            (right-associative: 2^3^2 = 2^9)
 //   atom    := number | variable | constant | function '(' expr (',' expr)* ')' | '(' expr ')'
-// Variables: x0.., u0.., w0.. (state, input, disturbance components). Constants: names given to
+// Variables: x0.., u0.., w0.. (state, input, disturbance components); in a noise density only z. Constants: names given to
 // parse() (and pi). Functions: sin cos tan asin acos atan atan2 exp log sqrt pow abs min max floor
 // ceil, plus if(cond, a, b). Comparisons and logic give 1 or 0. Also: `cond ? a : b`.
 #include <cstddef>
@@ -39,8 +39,14 @@ class Expression {
                           std::size_t state_dims, std::size_t input_dims,
                           std::size_t disturbance_dims);
 
+  /// A noise density (docs/configuration.md, noise.density): the same grammar with one variable,
+  /// `z` (the noise value, state units), and no x, u, w. Throws ParseError (1-based column).
+  static Expression parse_density(const std::string& text, const std::map<std::string, double>& constants);
+
   /// Evaluates with the given component arrays (double precision).
   double evaluate(const double* x, const double* u, const double* w) const;
+  /// Evaluates an expression of z (parse_density()) at z.
+  double evaluate_density(double z) const;
 
   /// OpenCL C (and C++) expression text over arrays named `x`, `u`, `w` of type double; numbers
   /// are printed as c_double_literal() (format.hpp): the shortest text that reads back exactly. Example: "(x[0] + (10.0 * (u[0] * cos(u[1]))))".

@@ -17,17 +17,31 @@
 //                        contains [mu - h_i*eta_i, mu + h_i*eta_i] because |mu - nearest| <=
 //                        eta/2, so the cut mass per transition is at most gamma (union bound).
 //   uniform:             h_i = ceil(a_i*s/eta_i) covers the whole support: nothing is cut.
+// Exponential, beta and custom noise (noise_i = s_i * Z_i, s_i = 1 additive, |x_i| multiplicative)
+// keep an interval [zlo_i, zhi_i] of Z_i: cutting_probability gamma keeps, for the exponential,
+// [shift_i, shift_i + ln(n/gamma)/rate_i] (exactly gamma/n cut per dimension), for beta and custom
+// the whole support (nothing cut). Additive: the window is centred on the kept interval's centre,
+// nearest_i(mu + (zlo_i + zhi_i)/2) +- ceil((zhi_i - zlo_i)/(2 eta_i)); multiplicative: centred on
+// nearest_i(mu), h_i = ceil(max(|zlo_i|, |zhi_i|) * max|x_i| / eta_i). fixed_region r cuts at most
+// sum_i (1 - P(|s_i Z_i| <= h_i eta_i)) with s_i the largest scale.
 // Cells outside the window get probability 0, so every value computed is a lower bound.
 // Multiplicative noise: noise_i scales with |x_i| of the current state (diagonal only).
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "amytiss/config.hpp"
 #include "amytiss/grid.hpp"
 
 namespace amytiss {
+
+namespace detail {
+struct UnitLaw;
+}
 
 class NoiseModel {
  public:
@@ -36,17 +50,23 @@ class NoiseModel {
 
   /// `config` must have passed Config::validate() for these states (sizes, symmetric positive
   /// definite covariance, positive half-widths, truncation parameters); the constructor asserts
-  /// it (std::logic_error), it does not judge user input.
-  NoiseModel(const NoiseConfig& config, const Grid& states);
+  /// it (std::logic_error), it does not judge user input. `constants` are those custom densities
+  /// may use (the configuration's `constants`).
+  NoiseModel(const NoiseConfig& config, const Grid& states, const std::map<std::string, double>& constants = {});
 
   std::size_t dims() const { return dims_; }
   NoiseType type() const { return type_; }
   Distribution distribution() const { return distribution_; }
-  /// True when T is the product of per-dimension masses (normal diagonal, uniform).
+  /// True when T is the product of per-dimension masses (all but a full normal covariance).
   bool separable() const { return separable_; }
+  /// True for the laws whose masses the OpenCL dense sweep computes on the device (normal,
+  /// uniform); the others are computed on the host only (reference engine, factored sweep).
+  bool device_masses() const {
+    return distribution_ == Distribution::Normal || distribution_ == Distribution::Uniform;
+  }
 
   /// Scale of dimension `dim` at current state x: normal: standard deviation sqrt(Sigma_ii);
-  /// uniform: half-width; multiplicative: times |x[dim]|.
+  /// uniform: half-width; exponential, beta, custom: 1; multiplicative: times |x[dim]|.
   double scale(std::size_t dim, const double* x) const;
   /// Base scale (the additive one): stddev or half-width per dimension.
   const std::vector<double>& base_scale() const { return base_scale_; }
@@ -60,6 +80,14 @@ class NoiseModel {
   std::size_t window_cells() const;
   /// Upper bound of the probability mass a transition loses to truncation (0 for none/uniform).
   double cut_mass_bound() const { return cut_mass_bound_; }
+  /// Custom densities: bound of sum_x' |T computed - T exact| per transition from the adaptive
+  /// quadrature, prod_i (1 + w_i * 1e-12 + 1e-15) - 1 over the window widths w_i (each cell
+  /// mass to 1e-12 by its Gauss-Kronrod estimate, the normalization to 1e-15); 0 for the laws
+  /// with closed forms. An estimate-based bound (docs/semantics.md), like box_mass_tolerance().
+  double quadrature_error_bound() const { return quadrature_error_bound_; }
+  /// Centre offset of the window per dimension (state units): nearest_i(mu + offset_i) is its
+  /// middle cell. 0 except for additive exponential/beta/custom noise with an asymmetric kept interval.
+  const std::vector<double>& window_offset() const { return window_offset_; }
 
   /// Mass of [lo, hi] under the 1-d law of dimension dim with the given mean and scale (a scale of
   /// 0 is a point mass: 1 when lo <= mean < hi). Exact (erfc), double precision.
@@ -116,6 +144,9 @@ class NoiseModel {
                        const std::vector<double>& nodes, const std::vector<double>& weights) const;
   double cut_mass_bound_ = 0.0;
   double box_mass_tolerance_ = 0.0;
+  double quadrature_error_bound_ = 0.0;
+  std::vector<double> window_offset_;
+  std::vector<std::shared_ptr<const detail::UnitLaw>> laws_;  // exponential, beta, custom
   std::size_t grid_size_ = 1;
 };
 

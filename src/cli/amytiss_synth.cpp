@@ -144,6 +144,21 @@ void print_memory_estimate(const Abstraction& abstraction) {
               estimate.bytes_per_triple);
 }
 
+// What the abstraction may lose or add per transition: truncation only ever drops mass (values
+// stay lower bounds); a custom density's quadrature may err either way, at most T times its bound
+// in V_0 (docs/semantics.md).
+void print_error_budget(const Abstraction& abstraction) {
+  const NoiseModel& noise = *abstraction.noise;
+  std::printf("noise: %s %s, truncation %s: cut mass <= %.3g per transition", to_string(noise.type()).c_str(),
+              to_string(noise.distribution()).c_str(), to_string(abstraction.config.noise.truncation).c_str(),
+              noise.cut_mass_bound());
+  if (noise.quadrature_error_bound() > 0)
+    std::printf(", quadrature error <= %.3g per transition (|dV_0| <= %.3g over the horizon)",
+                noise.quadrature_error_bound(), noise.quadrature_error_bound() * double(abstraction.horizon));
+  if (!noise.separable()) std::printf(", box mass tolerance %.3g", noise.box_mass_tolerance());
+  std::printf("\n");
+}
+
 bool print_progress(const Progress& progress, bool quiet) {
   if (quiet || progress.phase != Phase::Synthesis) return true;
   std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
@@ -271,6 +286,7 @@ int run(const Options& options) {
               config_hash(config).c_str());
   print_sizes(abstraction);
   print_memory_estimate(abstraction);
+  print_error_budget(abstraction);
   std::printf("device: %s, transitions: %s\n", to_string(config.compute.device).c_str(),
               to_string(config.compute.transitions).c_str());
   std::fflush(stdout);

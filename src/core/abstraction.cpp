@@ -66,7 +66,7 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
               dynamics->disturbance_dims() == abstraction.disturbances.dims(),
           "a dynamics with the grids' state, input and disturbance dimensions");
   abstraction.dynamics = std::move(dynamics);
-  abstraction.noise = std::make_shared<NoiseModel>(config.noise, abstraction.states);
+  abstraction.noise = std::make_shared<NoiseModel>(config.noise, abstraction.states, config.constants);
   require(config.spec.horizon > 0, "a horizon of at least one step");
   abstraction.spec = config.spec.type;
   abstraction.horizon = config.spec.horizon;

@@ -1,9 +1,12 @@
 #pragma once
 // Helpers shared by reading a configuration (config_yaml.cpp) and validating it
 // (config_validate.cpp): error messages that name the key, the value and an example.
+#include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
 
@@ -32,6 +35,16 @@ inline std::string format_list(const std::vector<double>& values) {
   std::string text = "[";
   for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + format_number(values[i]);
   return text + "]";
+}
+
+/// The checks of the `noise` section for n state dimensions (config_noise.cpp); custom densities
+/// may use `constants`.
+void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::string, double>& constants);
+
+/// Throws ConfigError naming key[i] for the first value that is NaN or infinite.
+inline void check_finite_list(const std::vector<double>& values, const std::string& key, const std::string& example) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i])) fail(indexed(key, i), format_number(values[i]), "a finite number", example);
 }
 
 }  // namespace amytiss::detail

@@ -48,6 +48,15 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   text += "  distribution: " + to_string(noise.distribution) + "\n";
   if (!noise.covariance.empty()) text += "  covariance: " + format_list(noise.covariance) + "\n";
   if (!noise.half_width.empty()) text += "  half_width: " + format_list(noise.half_width) + "\n";
+  if (!noise.rate.empty()) text += "  rate: " + format_list(noise.rate) + "\n";
+  if (!noise.shift.empty()) text += "  shift: " + format_list(noise.shift) + "\n";
+  if (!noise.alpha.empty()) text += "  alpha: " + format_list(noise.alpha) + "\n";
+  if (!noise.beta.empty()) text += "  beta: " + format_list(noise.beta) + "\n";
+  if (!noise.density.empty()) {
+    text += "  density:\n";
+    for (const auto& expression : noise.density) text += "    - " + quoted(expression) + "\n";
+  }
+  if (noise.support) text += "  support: " + box_yaml(*noise.support) + "\n";
   text += "  truncation: " + to_string(noise.truncation) + "\n";
   if (noise.truncation == Truncation::CuttingProbability)
     text += "  cutting_probability: " + format_number(noise.cutting_probability) + "\n";

@@ -7,12 +7,13 @@
 #include "amytiss/config.hpp"
 #include "amytiss/expression.hpp"
 #include "amytiss/model.hpp"
-#include "amytiss/noise.hpp"
 #include "config_messages.hpp"
 
 namespace amytiss {
 namespace {
 
+using detail::check_finite_list;
+using detail::check_noise;
 using detail::fail;
 using detail::format_list;
 using detail::indexed;
@@ -20,18 +21,11 @@ using detail::join;
 
 constexpr std::uint64_t kMaxGridPoints = 4294967295ull;          // 2^32 - 1: indices are uint32
 constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
-// Covariance entries (r, k) and (k, r) may differ by this much relative to max(1, |entry|).
-constexpr double kSymmetryTolerance = 1e-12;
 
 const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
 
 std::uint64_t points_of_dimension(double lb, double ub, double eta) {
   return static_cast<std::uint64_t>(std::floor((ub - lb) / eta + 0.5)) + 1;
-}
-
-void check_finite_list(const std::vector<double>& values, const std::string& key, const std::string& example) {
-  for (std::size_t i = 0; i < values.size(); ++i)
-    if (!std::isfinite(values[i])) fail(indexed(key, i), format_number(values[i]), "a finite number", example);
 }
 
 /// Checks a grid and returns its number of points (saturated at UINT64_MAX).
@@ -136,86 +130,6 @@ bool looks_like_variable(const std::string& name) {
 const std::vector<std::string> kFunctionNames = {"sin", "cos",  "tan", "asin", "acos", "atan",  "atan2", "exp", "log",
                                                  "sqrt", "pow", "abs", "min", "max",  "floor", "ceil",  "if"};
 
-void check_noise(const NoiseConfig& noise, std::size_t n) {
-  const std::string n_text = std::to_string(n);
-  if (noise.distribution == Distribution::Normal) {
-    const std::string example = n == 2 ? "covariance: [0.75, 0.75]" : "covariance: [" + n_text + " variances]";
-    if (!noise.half_width.empty())
-      throw ConfigError("noise.half_width", "given for distribution normal; it is only used by distribution uniform");
-    const auto& c = noise.covariance;
-    if (c.size() != n && c.size() != n * n)
-      fail("noise.covariance", std::to_string(c.size()) + " values",
-           n_text + " values (diagonal) or " + std::to_string(n * n) + " values (full matrix, row-major)", example);
-    check_finite_list(c, "noise.covariance", example);
-    if (c.size() == n) {
-      for (std::size_t i = 0; i < n; ++i)
-        if (c[i] < 0)
-          fail(indexed("noise.covariance", i), format_number(c[i]),
-               "a variance >= 0 (0: no noise in that dimension)", example);
-    } else {
-      if (noise.type == NoiseType::Multiplicative)
-        throw ConfigError("noise.covariance",
-                          "a full covariance matrix with multiplicative noise is not supported; give the " + n_text +
-                              " diagonal variances (example: " + example + ")");
-      bool diagonal = true;
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t k = 0; k < n; ++k)
-          if (r != k && c[r * n + k] != 0.0) diagonal = false;
-      if (!diagonal && n > NoiseModel::kMaxFullCovarianceDims)
-        throw ConfigError("noise.covariance",
-                          "a full (non-diagonal) covariance is supported up to " +
-                              std::to_string(NoiseModel::kMaxFullCovarianceDims) + " state dimensions, got " + n_text +
-                              " (the quadrature cost grows like points^(n-1)); give the " + n_text +
-                              " diagonal variances (example: " + example + ")");
-      const auto entry = [&](std::size_t r, std::size_t k) { return c[r * n + k]; };
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t k = r + 1; k < n; ++k)
-          if (std::fabs(entry(r, k) - entry(k, r)) >
-              kSymmetryTolerance * std::max(1.0, std::max(std::fabs(entry(r, k)), std::fabs(entry(k, r)))))
-            throw ConfigError("noise.covariance",
-                              "got a matrix that is not symmetric: entry (" + std::to_string(r) + "," +
-                                  std::to_string(k) + ") = " + format_number(entry(r, k)) + " but (" +
-                                  std::to_string(k) + "," + std::to_string(r) + ") = " + format_number(entry(k, r)) +
-                                  "; expected a symmetric positive definite " + n_text + "x" + n_text +
-                                  " matrix, row-major");
-      // The same factorization the noise model computes its masses with.
-      if (!cholesky_factor(c, n))
-        throw ConfigError("noise.covariance", "got " + format_list(c) +
-                                                  ", which is not positive definite (Cholesky failed); expected a "
-                                                  "symmetric positive definite " + n_text + "x" + n_text +
-                                                  " matrix, row-major, or " + n_text + " positive variances");
-    }
-  } else {
-    const std::string example = "half_width: [" + n_text + " positive numbers]";
-    if (!noise.covariance.empty())
-      throw ConfigError("noise.covariance",
-                        "given for distribution uniform; use noise.half_width (example: " + example + ")");
-    if (noise.half_width.size() != n)
-      fail("noise.half_width", std::to_string(noise.half_width.size()) + " values", n_text + " values (one per state)",
-           example);
-    check_finite_list(noise.half_width, "noise.half_width", example);
-    for (std::size_t i = 0; i < n; ++i)
-      if (noise.half_width[i] <= 0)
-        fail(indexed("noise.half_width", i), format_number(noise.half_width[i]), "a number > 0", example);
-  }
-  if (!(noise.cutting_probability > 0 && noise.cutting_probability < 1))
-    fail("noise.cutting_probability", format_number(noise.cutting_probability), "a probability in (0, 1)",
-         "cutting_probability: 1.0e-3");
-  if (noise.truncation == Truncation::FixedRegion) {
-    const std::string example = "fixed_region: [" + n_text + " half-widths in state units]";
-    if (noise.fixed_region.size() != n)
-      fail("noise.fixed_region", std::to_string(noise.fixed_region.size()) + " values",
-           n_text + " values (one per state)", example);
-    check_finite_list(noise.fixed_region, "noise.fixed_region", example);
-    for (std::size_t i = 0; i < n; ++i)
-      if (noise.fixed_region[i] <= 0)
-        fail(indexed("noise.fixed_region", i), format_number(noise.fixed_region[i]), "a number > 0", example);
-  } else if (!noise.fixed_region.empty()) {
-    throw ConfigError("noise.fixed_region", "given but noise.truncation is " + to_string(noise.truncation) +
-                                                "; set truncation: fixed_region to use it");
-  }
-}
-
 }  // namespace
 
 void Config::validate() const {
@@ -230,12 +144,13 @@ void Config::validate() const {
 
   for (const auto& constant : constants) {
     const std::string key = "constants." + constant.first;
-    bool reserved = constant.first == "pi" || looks_like_variable(constant.first);
+    // z is the variable of noise densities.
+    bool reserved = constant.first == "pi" || constant.first == "z" || looks_like_variable(constant.first);
     for (const auto& function : kFunctionNames) reserved = reserved || function == constant.first;
     if (!is_identifier(constant.first) || reserved)
       throw ConfigError(key, "got the name '" + constant.first +
                                  "', expected a name of letters, digits and '_' that is not pi, a variable "
-                                 "(x0, u1, ...) or a function (example: constants: {tau: 10.0})");
+                                 "(x0, u1, ..., z) or a function (example: constants: {tau: 10.0})");
     if (!std::isfinite(constant.second)) fail(key, format_number(constant.second), "a finite number", "tau: 10.0");
   }
 
@@ -268,7 +183,7 @@ void Config::validate() const {
     check_dims("disturbances.lb", p, info->disturbance_dims);
   }
 
-  check_noise(noise, n);
+  check_noise(noise, n, constants);
 
   if (spec.horizon == 0) fail("spec.horizon", "0", "an integer >= 1 (number of time steps)", "horizon: 16");
   switch (spec.type) {

@@ -123,19 +123,27 @@ Config config_from_yaml(const YAML::Node& root) {
   if (present(root["model"])) config.model = read_string(root["model"], "model", "model: bmw320i");
 
   const YAML::Node noise = required(root, "noise", "noise", "noise: {covariance: [0.75, 0.75]}");
-  check_keys(noise, "noise", {"type", "distribution", "covariance", "half_width", "truncation", "cutting_probability",
-                              "fixed_region"},
+  check_keys(noise, "noise", {"type", "distribution", "covariance", "half_width", "rate", "shift", "alpha", "beta",
+                              "density", "support", "truncation", "cutting_probability", "fixed_region"},
              "noise: {covariance: [0.75, 0.75]}");
   if (present(noise["type"]))
     config.noise.type = read_enum<NoiseType>(noise["type"], "noise.type", "type: additive");
-  if (present(noise["distribution"])) {
-    const std::string distribution = read_string(noise["distribution"], "noise.distribution", "distribution: normal");
-    if (distribution == "exponential" || distribution == "beta" || distribution == "custom")
-      throw ConfigError("noise.distribution", "got '" + distribution +
-                                                  "', which is not supported yet (supported: normal, uniform; "
-                                                  "example: distribution: normal)");
+  if (present(noise["distribution"]))
     config.noise.distribution = read_enum<Distribution>(
         noise["distribution"], "noise.distribution", "distribution: normal");
+  if (present(noise["rate"])) config.noise.rate = read_number_list(noise["rate"], "noise.rate", "rate: [2.0, 2.0]");
+  if (present(noise["shift"]))
+    config.noise.shift = read_number_list(noise["shift"], "noise.shift", "shift: [-0.5, -0.5]");
+  if (present(noise["alpha"])) config.noise.alpha = read_number_list(noise["alpha"], "noise.alpha", "alpha: [2, 2]");
+  if (present(noise["beta"])) config.noise.beta = read_number_list(noise["beta"], "noise.beta", "beta: [5, 5]");
+  if (present(noise["support"]))
+    config.noise.support = read_box(noise["support"], "noise.support", "{lb: [-1, -1], ub: [1, 1]}");
+  const char* const density_example = "density: [\"0.5*exp(-abs(z))\", \"0.5*exp(-abs(z))\"]";
+  if (present(noise["density"])) {
+    const YAML::Node density = noise["density"];
+    if (!density.IsSequence()) fail("noise.density", node_text(density), "a list of expressions of z", density_example);
+    for (std::size_t i = 0; i < density.size(); ++i)
+      config.noise.density.push_back(read_string(density[i], indexed("noise.density", i), density_example));
   }
   if (present(noise["covariance"]))
     config.noise.covariance = read_number_list(noise["covariance"], "noise.covariance", "covariance: [0.75, 0.75]");

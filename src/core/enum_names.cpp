@@ -34,8 +34,12 @@ const std::vector<std::pair<const char*, NoiseType>>& enum_names() {
 }
 template <>
 const std::vector<std::pair<const char*, Distribution>>& enum_names() {
-  static const std::vector<std::pair<const char*, Distribution>> names = {{"normal", Distribution::Normal},
-                                                                          {"uniform", Distribution::Uniform}};
+  static const std::vector<std::pair<const char*, Distribution>> names = {
+      {"normal", Distribution::Normal},
+      {"uniform", Distribution::Uniform},
+      {"exponential", Distribution::Exponential},
+      {"beta", Distribution::Beta},
+      {"custom", Distribution::Custom}};
   return names;
 }
 template <>

@@ -12,7 +12,7 @@
 namespace amytiss {
 
 enum class NodeKind { Number, Variable, Unary, Binary, Call, Conditional };
-enum class VariableSpace { State, Input, Disturbance };
+enum class VariableSpace { State, Input, Disturbance, Noise };
 // Resolved when the node is built so that evaluation switches on an integer, never on text.
 enum class Operation {
   None, Negate, Not, Add, Subtract, Multiply, Divide, Power, Less, LessEqual, Greater, GreaterEqual,
@@ -191,9 +191,9 @@ NodePtr make_operator(NodeKind kind, const std::string& op, std::vector<NodePtr>
 class Parser {
  public:
   Parser(const std::string& text, const std::map<std::string, double>& constants, std::size_t state_dims,
-         std::size_t input_dims, std::size_t disturbance_dims)
+         std::size_t input_dims, std::size_t disturbance_dims, bool noise_variable = false)
       : tokens_(tokenize(text)), constants_(constants),
-        dims_{state_dims, input_dims, disturbance_dims} {}
+        dims_{state_dims, input_dims, disturbance_dims}, noise_variable_(noise_variable) {}
 
   NodePtr parse_all() {
     NodePtr root = parse_expr();
@@ -335,7 +335,7 @@ class Parser {
 
   std::string variable_ranges() const {
     static const char kLetters[] = {'x', 'u', 'w'};
-    std::string ranges;
+    std::string ranges = noise_variable_ ? "z" : "";
     for (int space = 0; space < 3; ++space) {
       if (dims_[space] == 0) continue;
       if (!ranges.empty()) ranges += ", ";
@@ -347,6 +347,12 @@ class Parser {
 
   NodePtr parse_variable(const Token& token) {
     const std::string& name = token.text;
+    if (noise_variable_ && name == "z") {
+      auto node = std::make_shared<ExpressionNode>();
+      node->kind = NodeKind::Variable;
+      node->space = VariableSpace::Noise;
+      return node;
+    }
     if (name.size() < 2) return nullptr;
     const std::string letters = "xuw";
     const auto space = letters.find(name[0]);
@@ -403,9 +409,10 @@ class Parser {
   std::size_t position_ = 0;
   const std::map<std::string, double>& constants_;
   std::size_t dims_[3];
+  bool noise_variable_ = false;  // a density: `z` is the only variable
 };
 
-double evaluate_node(const ExpressionNode& node, const double* x, const double* u, const double* w) {
+double evaluate_node(const ExpressionNode& node, const double* x, const double* u, const double* w, double z) {
   switch (node.kind) {
     case NodeKind::Number: return node.number;
     case NodeKind::Variable:
@@ -413,22 +420,23 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
         case VariableSpace::State: return x[node.index];
         case VariableSpace::Input: return u[node.index];
         case VariableSpace::Disturbance: return w[node.index];
+        case VariableSpace::Noise: return z;
       }
       return 0.0;
     case NodeKind::Unary: {
-      const double operand = evaluate_node(*node.children[0], x, u, w);
+      const double operand = evaluate_node(*node.children[0], x, u, w, z);
       return node.operation == Operation::Negate ? -operand : (operand == 0.0 ? 1.0 : 0.0);
     }
     case NodeKind::Conditional:
-      return evaluate_node(*node.children[0], x, u, w) != 0.0 ? evaluate_node(*node.children[1], x, u, w)
-                                                               : evaluate_node(*node.children[2], x, u, w);
+      return evaluate_node(*node.children[0], x, u, w, z) != 0.0 ? evaluate_node(*node.children[1], x, u, w, z)
+                                                               : evaluate_node(*node.children[2], x, u, w, z);
     case NodeKind::Binary: {
-      const double left = evaluate_node(*node.children[0], x, u, w);
+      const double left = evaluate_node(*node.children[0], x, u, w, z);
       if (node.operation == Operation::And)
-        return (left != 0.0 && evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
+        return (left != 0.0 && evaluate_node(*node.children[1], x, u, w, z) != 0.0) ? 1.0 : 0.0;
       if (node.operation == Operation::Or)
-        return (left != 0.0 || evaluate_node(*node.children[1], x, u, w) != 0.0) ? 1.0 : 0.0;
-      const double right = evaluate_node(*node.children[1], x, u, w);
+        return (left != 0.0 || evaluate_node(*node.children[1], x, u, w, z) != 0.0) ? 1.0 : 0.0;
+      const double right = evaluate_node(*node.children[1], x, u, w, z);
       switch (node.operation) {
         case Operation::Add: return left + right;
         case Operation::Subtract: return left - right;
@@ -445,7 +453,7 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
       }
     }
     case NodeKind::Call: {
-      const double a = evaluate_node(*node.children[0], x, u, w);
+      const double a = evaluate_node(*node.children[0], x, u, w, z);
       switch (node.operation) {
         case Operation::Sin: return std::sin(a);
         case Operation::Cos: return std::cos(a);
@@ -461,7 +469,7 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
         case Operation::Ceil: return std::ceil(a);
         default: break;
       }
-      const double b = evaluate_node(*node.children[1], x, u, w);
+      const double b = evaluate_node(*node.children[1], x, u, w, z);
       switch (node.operation) {
         case Operation::Atan2: return std::atan2(a, b);
         case Operation::Pow: return std::pow(a, b);
@@ -484,6 +492,7 @@ std::string to_c_node(const ExpressionNode& node) {
   switch (node.kind) {
     case NodeKind::Number: return c_number(node.number);
     case NodeKind::Variable: {
+      if (node.space == VariableSpace::Noise) return "z";
       static const char kNames[] = {'x', 'u', 'w'};
       return std::string(1, kNames[static_cast<int>(node.space)]) + "[" + std::to_string(node.index) + "]";
     }
@@ -527,14 +536,24 @@ Expression Expression::parse(const std::string& text, const std::map<std::string
   return expression;
 }
 
-double Expression::evaluate(const double* x, const double* u, const double* w) const {
-  return evaluate_node(*root_, x, u, w);
+Expression Expression::parse_density(const std::string& text, const std::map<std::string, double>& constants) {
+  Parser parser(text, constants, 0, 0, 0, true);
+  Expression expression;
+  expression.root_ = parser.parse_all();
+  expression.text_ = text;
+  return expression;
 }
+
+double Expression::evaluate(const double* x, const double* u, const double* w) const {
+  return evaluate_node(*root_, x, u, w, 0.0);
+}
+
+double Expression::evaluate_density(double z) const { return evaluate_node(*root_, nullptr, nullptr, nullptr, z); }
 
 std::string Expression::to_c() const { return to_c_node(*root_); }
 
 VariableUse Expression::variables() const {
-  std::vector<char> seen[3];
+  std::vector<char> seen[4];
   // An explicit stack: the walk's depth must not depend on the expression's nesting.
   std::vector<const ExpressionNode*> pending{root_.get()};
   while (!pending.empty()) {

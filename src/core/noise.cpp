@@ -8,6 +8,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
+#include "noise_laws.hpp"
 
 namespace amytiss {
 namespace {
@@ -127,7 +128,7 @@ double normal_upper_quantile(double p) {
   return -x;
 }
 
-NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
+NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states, const std::map<std::string, double>& constants)
     : dims_(states.dims()),
       type_(config.type),
       distribution_(config.distribution),
@@ -164,12 +165,18 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
     for (std::size_t i = 0; i < n; ++i) base_scale_[i] = std::sqrt(covariance_[i * n + i]);
     require(separable_ || (type_ == NoiseType::Additive && n <= kMaxFullCovarianceDims),
             "a full covariance only with additive noise and at most kMaxFullCovarianceDims dimensions");
-  } else {
+  } else if (distribution_ == Distribution::Uniform) {
     require(config.half_width.size() == n, "one half-width per dimension");
     for (std::size_t i = 0; i < n; ++i) require(config.half_width[i] > 0, "positive half-widths");
     base_scale_ = config.half_width;
     separable_ = true;
+  } else {
+    // noise_i = scale * Z_i with the unit law of Z_i (noise_laws.hpp).
+    for (std::size_t i = 0; i < n; ++i) laws_.push_back(std::make_shared<detail::UnitLaw>(detail::unit_law(config, i, constants)));
+    base_scale_.assign(n, 1.0);
+    separable_ = true;
   }
+  window_offset_.assign(n, 0.0);
 
   // The largest scale per dimension over the grid bounds the window for every current state.
   std::vector<double> largest_scale(n);
@@ -205,8 +212,10 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
         if (largest_scale[i] > 0) {
           if (distribution_ == Distribution::Normal)
             cut += 2.0 * upper_tail(kept / largest_scale[i]);
-          else
+          else if (distribution_ == Distribution::Uniform)
             cut += std::max(0.0, 1.0 - kept / largest_scale[i]);
+          else  // P(|s Z| > kept) grows with s: the largest scale bounds every state's cut.
+            cut += std::max(0.0, 1.0 - laws_[i]->mass(-kept / largest_scale[i], kept / largest_scale[i]));
         }
       }
       cut_mass_bound_ = std::min(1.0, cut);
@@ -225,6 +234,25 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
             cut += 2.0 * upper_tail(double(window_half_cells_[i]) * eta_[i] / largest_scale[i]);
         }
         cut_mass_bound_ = std::min(gamma, cut);
+      } else if (!laws_.empty()) {
+        // The kept interval [zlo, zhi] of Z: the exponential's upper tail beyond it has mass
+        // exp(-rate*ln(n/gamma)/rate) = gamma/n; beta and custom keep their whole support.
+        double cut = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+          const detail::UnitLaw& law = *laws_[i];
+          double zlo = law.lo, zhi = law.hi;
+          if (law.distribution == Distribution::Exponential) {
+            zhi = law.shift + std::log(double(std::max<std::size_t>(n, 1)) / gamma) / law.rate;
+            if (largest_scale[i] > 0) cut += gamma / double(std::max<std::size_t>(n, 1));
+          }
+          if (type_ == NoiseType::Additive) {
+            window_offset_[i] = 0.5 * (zlo + zhi);
+            set_half(i, std::ceil(0.5 * (zhi - zlo) / eta_[i]));
+          } else {
+            set_half(i, std::ceil(std::max(std::fabs(zlo), std::fabs(zhi)) * largest_scale[i] / eta_[i]));
+          }
+        }
+        cut_mass_bound_ = std::min(gamma, cut);
       } else {
         // The window covers the whole support of the uniform law: nothing is cut.
         for (std::size_t i = 0; i < n; ++i) set_half(i, std::ceil(largest_scale[i] / eta_[i]));
@@ -239,7 +267,18 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
     if (largest_scale[i] == 0.0) {
       window_half_cells_[i] = 0;
       whole_grid_dims_[i] = 0;
+      window_offset_[i] = 0.0;
     }
+  }
+  if (distribution_ == Distribution::Custom) {
+    // Each cell mass within kCustomMassTolerance, the normalization within 1e-15 relative: the
+    // row's l1 error is at most prod_i (1 + E_i) - 1 with E_i the dimension's summed mass error.
+    double product = 1.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double cells = std::min<double>(double(2 * window_half_cells_[i] + 1), double(counts_[i]));
+      product *= 1.0 + cells * detail::UnitLaw::kCustomMassTolerance + 1e-15;
+    }
+    quadrature_error_bound_ = product - 1.0;
   }
 
   if (!separable_) {
@@ -299,11 +338,12 @@ std::size_t NoiseModel::window_cells() const {
   return std::min(cells, grid_size_);
 }
 
-double NoiseModel::interval_mass(std::size_t /*dim*/, double lo, double hi, double mean, double scale) const {
+double NoiseModel::interval_mass(std::size_t dim, double lo, double hi, double mean, double scale) const {
   if (!(lo < hi)) return 0.0;
   if (scale == 0.0) return (lo <= mean && mean < hi) ? 1.0 : 0.0;
   if (distribution_ == Distribution::Normal)
     return standard_normal_interval((lo - mean) / scale, (hi - mean) / scale);
+  if (!laws_.empty()) return laws_[dim]->mass((lo - mean) / scale, (hi - mean) / scale);
   const double overlap = std::min(hi, mean + scale) - std::max(lo, mean - scale);
   return overlap > 0 ? std::min(1.0, overlap / (2.0 * scale)) : 0.0;
 }
@@ -421,7 +461,7 @@ bool NoiseModel::dimension_window(const Grid& states, std::size_t dim, double me
   }
   // A non-finite post state carries no mass onto the grid.
   if (!std::isfinite(mean)) return false;
-  const std::int64_t center = states.nearest(dim, mean);
+  const std::int64_t center = states.nearest(dim, mean + window_offset_[dim]);
   const std::int64_t half = window_half_cells_[dim];
   if (center - half > count - 1 || center + half < 0) return false;
   *first = std::max<std::int64_t>(0, center - half);

@@ -52,6 +52,14 @@ void check_dense_supported(const Layout& layout) {
 std::optional<FactoredPlan> choose_factored(const Abstraction& a, const DeviceInfo& device,
                                             const SynthesisOptions& options, SynthesisReport& rep) {
   const SweepChoice decomposition = options.compute.sweep;
+  // The dense sweep computes normal and uniform masses on the device; the other laws' masses come
+  // from the host's NoiseModel, which only the factored sweep's tables use.
+  const bool host_masses = !a.noise->device_masses();
+  const std::string law = to_string(a.noise->distribution());
+  if (host_masses && decomposition == SweepChoice::Dense)
+    throw ConfigError("compute.sweep", "got dense, but the dense sweep computes normal and uniform noise only; " + law +
+                                           " noise runs on the factored sweep (compute.sweep: auto or factored, "
+                                           "with dynamics expressions) or on compute.device: reference");
   if (decomposition == SweepChoice::Dense) {
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, "dense sweep (requested)"});
     return std::nullopt;
@@ -64,9 +72,17 @@ std::optional<FactoredPlan> choose_factored(const Abstraction& a, const DeviceIn
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, plan->describe() + " (requested)"});
     return plan;
   }
+  if (!plan && host_masses)
+    throw ConfigError("noise.distribution", law + " noise needs the factored sweep on OpenCL devices (the dense sweep "
+                                              "computes normal and uniform noise only), which cannot run: " + reason +
+                                              "; use dynamics expressions or compute.device: reference");
   if (!plan) {
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, "dense sweep: the factored sweep cannot run: " + reason});
     return std::nullopt;
+  }
+  if (host_masses) {
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, plan->describe() + " (" + law + " noise: host masses)"});
+    return plan;
   }
   if (plan->multiply_adds > kFactoredShareLimit * plan->dense_multiply_adds) {
     rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep,

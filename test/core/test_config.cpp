@@ -267,14 +267,16 @@ spec: {type: safety, horizon: 2}
   root["noise"]["type"] = "additve";
   expect_error(root, "noise.type", "got 'additve', expected one of additive, multiplicative");
 
+  // Each distribution has its own parameters (test_noise_laws.cpp tests them); the normal's
+  // covariance given with another distribution is named.
   for (const char* distribution : {"exponential", "beta", "custom"}) {
     root = base();
     root["noise"]["distribution"] = distribution;
-    expect_error(root, "noise.distribution", "not supported yet (supported: normal, uniform");
+    expect_error(root, "noise.covariance", "it is only used by distribution normal");
   }
   root = base();
   root["noise"]["distribution"] = "gaussian";
-  expect_error(root, "noise.distribution", "expected one of normal, uniform");
+  expect_error(root, "noise.distribution", "expected one of normal, uniform, exponential, beta, custom");
 
   root = base();
   root["noise"] = YAML::Load("{distribution: uniform, half_width: [0.5, 0.5]}");
@@ -286,7 +288,7 @@ spec: {type: safety, horizon: 2}
 
   root = base();
   root["noise"] = YAML::Load("{distribution: uniform, covariance: [0.5, 0.5]}");
-  expect_error(root, "noise.covariance", "use noise.half_width");
+  expect_error(root, "noise.covariance", "distribution uniform uses noise.half_width");
 
   for (const char* gamma : {"0", "1", "1.5"}) {
     root = base();
