@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -14,6 +15,7 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/enum_names.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/model_export.hpp"
 #include "amytiss/policy.hpp"
 #include "amytiss/policy_file.hpp"
 
@@ -37,6 +39,9 @@ constexpr const char* kUsage =
     "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
     "  --profile                          per-phase timing, rates and memory table\n"
     "  --compare-reference                also run the serial reference engine and compare V_0\n"
+    "  --export prism|drn DIR             write the finite abstraction (PRISM explicit files or Storm\n"
+    "                                     DRN, with a README) into DIR and exit (docs/export.md)\n"
+    "  --export-max-transitions N         refuse to export more transitions (default 10000000)\n"
     "  --list-devices                     list the OpenCL devices and exit\n"
     "  --quiet                            no progress lines\n"
     "  --help                             this text\n"
@@ -56,6 +61,9 @@ struct Options {
   std::string sweep;        // empty: the configuration's
   std::string platform;
   std::string output;
+  std::string export_format;  // empty: no export
+  std::string export_directory;
+  std::size_t export_max_transitions = 10000000;
   bool profile = false;
   bool compare_reference = false;
   bool list_devices = false;
@@ -78,6 +86,20 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--sweep") options.sweep = value();
     else if (arg == "--platform") options.platform = value();
     else if (arg == "--output" || arg == "-o") options.output = value();
+    else if (arg == "--export") {
+      options.export_format = value();
+      options.export_directory = value();
+      if (options.export_format != "prism" && options.export_format != "drn")
+        throw UsageError("--export: got '" + options.export_format + "', expected prism or drn (example: --export "
+                         "prism out/)");
+    } else if (arg == "--export-max-transitions") {
+      const std::string text = value();
+      char* end = nullptr;
+      const unsigned long long limit = std::strtoull(text.c_str(), &end, 10);
+      if (text.empty() || *end != '\0' || text[0] == '-')
+        throw UsageError("--export-max-transitions: got '" + text + "', expected a whole number (example: 50000000)");
+      options.export_max_transitions = std::size_t(limit);
+    }
     else if (arg == "--profile") options.profile = true;
     else if (arg == "--compare-reference") options.compare_reference = true;
     else if (arg == "--list-devices") options.list_devices = true;
@@ -287,6 +309,15 @@ int run(const Options& options) {
   print_sizes(abstraction);
   print_memory_estimate(abstraction);
   print_error_budget(abstraction);
+  if (!options.export_format.empty()) {
+    const ExportFormat format = options.export_format == "prism" ? ExportFormat::Prism : ExportFormat::Drn;
+    const ExportSummary summary =
+        export_model(abstraction, format, options.export_directory, options.export_max_transitions);
+    std::printf("exported %s: %zu states, %zu choices, %zu transitions\n", options.export_format.c_str(),
+                summary.states, summary.choices, summary.transitions);
+    for (const auto& file : summary.files) std::printf("wrote %s\n", file.c_str());
+    return 0;
+  }
   std::printf("device: %s, transitions: %s\n", to_string(config.compute.device).c_str(),
               to_string(config.compute.transitions).c_str());
   std::fflush(stdout);
@@ -339,6 +370,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s\n", error.what());
     return 2;
   } catch (const ConfigError& error) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 2;
+  } catch (const ExportTooLarge& error) {
     std::fflush(stdout);
     std::fprintf(stderr, "error: %s\n", error.what());
     return 2;
