@@ -31,7 +31,9 @@ struct Abstraction {
   std::shared_ptr<const NoiseModel> noise;
   std::vector<CellRole> roles;  ///< per state cell (flat index)
   SpecType spec = SpecType::Safety;
-  unsigned horizon = 0;
+  unsigned horizon = 0;  ///< T_d; 1 for an unbounded specification (one stationary step)
+  bool unbounded = false;  ///< horizon: infinite (interval iteration, stationary policy)
+  double tolerance = 0;    ///< unbounded: stop when upper - lower <= tolerance everywhere
 
   /// Validates and builds. Throws ConfigError.
   static Abstraction from_config(const Config& config);

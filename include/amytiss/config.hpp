@@ -61,7 +61,11 @@ enum class SpecType { Safety, Reachability, ReachAvoid };
 
 struct SpecConfig {
   SpecType type = SpecType::Safety;
-  unsigned horizon = 0;       ///< T_d, number of steps, >= 1
+  unsigned horizon = 0;       ///< T_d, number of steps, >= 1 (0 when unbounded)
+  /// `horizon: infinite`: the unbounded specification, solved by interval iteration until the
+  /// upper and the lower bound differ by at most `tolerance` everywhere; the policy is stationary.
+  bool unbounded = false;
+  double tolerance = 1e-6;    ///< unbounded only: in (0, 1)
   std::optional<Box> safe;    ///< safety; absent: the whole grid
   std::optional<Box> target;  ///< reachability, reach_avoid
   std::optional<Box> avoid;   ///< reach_avoid (absent: empty)

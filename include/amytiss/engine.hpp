@@ -52,7 +52,8 @@ enum class NoteKind {
   Sweep,           ///< work decomposition of the synthesis sweep
   Chunking,        ///< states split into chunks (allocation limits)
   DeviceMemory,    ///< device memory allocated
-  KernelBuild      ///< program built from source or loaded from the binary cache
+  KernelBuild,     ///< program built from source or loaded from the binary cache
+  Convergence      ///< unbounded specifications: end components, iterations, the gap reached
 };
 std::string to_string(NoteSeverity severity);
 std::string to_string(NoteKind kind);

@@ -24,6 +24,14 @@ struct Policy {
   /// hold input 0.
   std::vector<std::uint32_t> input_index;
   std::vector<CellRole> roles;
+  /// Unbounded specification (horizon: infinite): the policy is stationary, `horizon` is 1,
+  /// values rows 0 and 1 both hold the certified lower bound (the probability the stored
+  /// policy guarantees), `upper_values` the upper bound of the optimal value per cell, and
+  /// lookup() ignores the step.
+  bool stationary = false;
+  std::vector<double> upper_values;
+  unsigned iterations = 0;  ///< interval iterations done (stationary only)
+  double gap = 0;           ///< max over cells of upper - lower (stationary only)
   /// What computed it (device name or "reference") and the configuration's hash.
   std::string computed_by;
   std::string config_hash;
@@ -33,7 +41,8 @@ struct Policy {
     return input_index[std::size_t(step) * states.size() + cell];
   }
 
-  /// Concrete state -> input and probability for time step `step` (0 <= step < horizon).
+  /// Concrete state -> input and probability for time step `step` (0 <= step < horizon; any step
+  /// for a stationary policy).
   /// Writes inputs.dims() values to input_out and V_step(cell) to probability_out on Ok. No
   /// allocation, O(dimension).
   LookupStatus lookup(const double* state, std::size_t state_length, unsigned step,

@@ -67,9 +67,12 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
           "a dynamics with the grids' state, input and disturbance dimensions");
   abstraction.dynamics = std::move(dynamics);
   abstraction.noise = std::make_shared<NoiseModel>(config.noise, abstraction.states, config.constants);
-  require(config.spec.horizon > 0, "a horizon of at least one step");
+  require(config.spec.unbounded || config.spec.horizon > 0, "a horizon of at least one step");
   abstraction.spec = config.spec.type;
-  abstraction.horizon = config.spec.horizon;
+  abstraction.unbounded = config.spec.unbounded;
+  abstraction.tolerance = config.spec.tolerance;
+  // An unbounded specification's stationary policy is laid out like one step of a finite one.
+  abstraction.horizon = config.spec.unbounded ? 1 : config.spec.horizon;
   abstraction.roles = cell_roles(abstraction.states, config.spec);
   return abstraction;
 }

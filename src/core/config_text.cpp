@@ -63,7 +63,12 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   if (!noise.fixed_region.empty()) text += "  fixed_region: " + format_list(noise.fixed_region) + "\n";
   text += "spec:\n";
   text += "  type: " + to_string(config.spec.type) + "\n";
-  text += "  horizon: " + std::to_string(config.spec.horizon) + "\n";
+  if (config.spec.unbounded) {
+    text += "  horizon: infinite\n";
+    text += "  tolerance: " + format_number(config.spec.tolerance) + "\n";
+  } else {
+    text += "  horizon: " + std::to_string(config.spec.horizon) + "\n";
+  }
   if (config.spec.safe) text += "  safe: " + box_yaml(*config.spec.safe) + "\n";
   if (config.spec.target) text += "  target: " + box_yaml(*config.spec.target) + "\n";
   if (config.spec.avoid) text += "  avoid: " + box_yaml(*config.spec.avoid) + "\n";

@@ -185,7 +185,12 @@ void Config::validate() const {
 
   check_noise(noise, n, constants);
 
-  if (spec.horizon == 0) fail("spec.horizon", "0", "an integer >= 1 (number of time steps)", "horizon: 16");
+  if (spec.unbounded) {
+    if (!(spec.tolerance > 0 && spec.tolerance < 1))
+      fail("spec.tolerance", format_number(spec.tolerance), "a number in (0, 1)", "tolerance: 1.0e-6");
+  } else if (spec.horizon == 0) {
+    fail("spec.horizon", "0", "an integer >= 1 (number of time steps) or infinite", "horizon: 16");
+  }
   switch (spec.type) {
     case SpecType::Safety:
       if (spec.target) throw ConfigError("spec.target", "given for spec.type safety; safety uses `safe` (or the whole grid)");
@@ -212,7 +217,9 @@ void Config::validate() const {
     fail("compute.memory_fraction", format_number(compute.memory_fraction), "a fraction in (0, 1]",
          "memory_fraction: 0.5");
 
-  const double policy_bytes = state_points * ((double(spec.horizon) + 1) * 8 + double(spec.horizon) * 4);
+  // An unbounded policy is stored like one step (and its upper bound).
+  const double stored_steps = spec.unbounded ? 2.0 : double(spec.horizon);
+  const double policy_bytes = state_points * ((stored_steps + 1) * 8 + stored_steps * 4);
   if (policy_bytes > kMaxPolicyBytes) {
     char text[300];
     std::snprintf(text, sizeof text,

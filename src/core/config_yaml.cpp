@@ -165,13 +165,26 @@ Config config_from_yaml(const YAML::Node& root) {
     config.noise.fixed_region = read_number_list(noise["fixed_region"], "noise.fixed_region", "fixed_region: [0.5, 0.5]");
 
   const YAML::Node spec = required(root, "spec", "spec", "spec: {type: safety, horizon: 8}");
-  check_keys(spec, "spec", {"type", "horizon", "safe", "target", "avoid"}, "spec: {type: safety, horizon: 8}");
+  check_keys(spec, "spec", {"type", "horizon", "tolerance", "safe", "target", "avoid"},
+             "spec: {type: safety, horizon: 8}");
   config.spec.type = read_enum<SpecType>(
       required(spec, "type", "spec.type", "type: reach_avoid"), "spec.type", "type: reach_avoid");
-  const double horizon = read_number(required(spec, "horizon", "spec.horizon", "horizon: 16"), "spec.horizon", "horizon: 16");
-  if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= 1e9))
-    fail("spec.horizon", spec["horizon"].Scalar(), "an integer >= 1 (number of time steps)", "horizon: 16");
-  config.spec.horizon = static_cast<unsigned>(horizon);
+  const YAML::Node horizon_node = required(spec, "horizon", "spec.horizon", "horizon: 16");
+  if (horizon_node.IsScalar() && horizon_node.Scalar() == "infinite") {
+    config.spec.unbounded = true;
+  } else {
+    const std::string horizon_example = "horizon: 16 (or horizon: infinite)";
+    const double horizon = read_number(horizon_node, "spec.horizon", horizon_example);
+    if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= 1e9))
+      fail("spec.horizon", horizon_node.Scalar(), "an integer >= 1 (number of time steps) or infinite", horizon_example);
+    config.spec.horizon = static_cast<unsigned>(horizon);
+  }
+  if (present(spec["tolerance"])) {
+    if (!config.spec.unbounded)
+      throw ConfigError("spec.tolerance", "given but spec.horizon is " + horizon_node.Scalar() +
+                                              "; the tolerance is for horizon: infinite");
+    config.spec.tolerance = read_number(spec["tolerance"], "spec.tolerance", "tolerance: 1.0e-6");
+  }
   if (present(spec["safe"])) config.spec.safe = read_box(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
   if (present(spec["target"])) config.spec.target = read_box(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
   if (present(spec["avoid"])) config.spec.avoid = read_box(spec["avoid"], "spec.avoid", "{lb: [-2, -2], ub: [2, 2]}");

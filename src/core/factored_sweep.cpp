@@ -9,6 +9,7 @@
 #include "amytiss/errors.hpp"
 #include "factored_program.hpp"
 #include "factored_tables.hpp"
+#include "interval_iteration.hpp"
 #include "opencl_program_cache.hpp"
 
 namespace amytiss::detail {
@@ -146,10 +147,14 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   // V's stride of the sliced dimension (row-major over the state grid).
   std::uint64_t sliced_stride = 1;
   for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
-  const auto synthesis_start = Clock::now();
   int current = 0;
-  for (unsigned step = a.horizon; step-- > 0;) {
-    phase_start = Clock::now();
+  // One Bellman step from values[current] (uploaded from host_in unless it is null: the previous
+  // step's output is already there) into values[1 - current], read back into host_out and chosen.
+  auto bellman = [&](const double* host_in, double* host_out, std::uint32_t* chosen) {
+    if (host_in)
+      check(clEnqueueWriteBuffer(run.queue, values[current].get(), CL_FALSE, 0, n_states * sizeof(double), host_in, 0,
+                                 nullptr, nullptr),
+            "clEnqueueWriteBuffer");
     for (std::size_t slice = 0; slice < plan.slices; ++slice) {
       const cl_uint block_first = cl_uint(slice * plan.slice_cells);
       for (std::size_t k = 0; k < plan.stages.size(); ++k) {
@@ -183,13 +188,27 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
     check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &roles_buffer.handle), "clSetKernelArg");
     launch(kernel, n_states, plan.stages.size());
     check(clEnqueueReadBuffer(run.queue, best_input.get(), CL_FALSE, 0, n_states * sizeof(cl_uint),
-                              policy.input_index.data() + std::size_t(step) * n_states, 0, nullptr, nullptr),
+                              chosen, 0, nullptr, nullptr),
           "clEnqueueReadBuffer");
     check(clEnqueueReadBuffer(run.queue, values[1 - current].get(), CL_FALSE, 0, n_states * sizeof(double),
-                              policy.values.data() + std::size_t(step) * n_states, 0, nullptr, nullptr),
+                              host_out, 0, nullptr, nullptr),
           "clEnqueueReadBuffer");
     check(clFinish(run.queue), "clFinish(factored sweep)");
     current = 1 - current;
+  };
+  if (a.unbounded) {
+    FunctionStep step(bellman, multiply_adds_per_step, bytes_per_step);
+    ReferenceStep host(a);
+    UnboundedRun unbounded{run.device->label(), [&](unsigned iterations, double) {
+                             if (run.progress) run.progress(Phase::Synthesis, iterations, -1);
+                           }};
+    return solve_unbounded(a, step, host, unbounded, report);
+  }
+  const auto synthesis_start = Clock::now();
+  for (unsigned step = a.horizon; step-- > 0;) {
+    phase_start = Clock::now();
+    bellman(nullptr, policy.values.data() + std::size_t(step) * n_states,
+            policy.input_index.data() + std::size_t(step) * n_states);
     const double seconds = seconds_since(phase_start);
     report.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
                              multiply_adds_per_step, bytes_per_step});

@@ -10,6 +10,7 @@
 #include "amytiss/errors.hpp"
 #include "device_peak.hpp"
 #include "factored_program.hpp"
+#include "interval_iteration.hpp"
 #include "opencl_device.hpp"
 #include "opencl_layout.hpp"
 #include "opencl_program_cache.hpp"
@@ -114,9 +115,8 @@ Policy empty_policy(const Abstraction& a, const std::string& device_label) {
   return policy;
 }
 
-// Step `step` of the policy's values from a padded value array.
-void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded_index, const double* padded) {
-  double* out = policy.values.data() + std::size_t(step) * padded_index.size();
+// The values of every state cell from a padded value array.
+void unpad(double* out, const std::vector<std::size_t>& padded_index, const double* padded) {
   for (std::size_t x = 0; x < padded_index.size(); ++x) out[x] = padded[padded_index[x]];
 }
 
@@ -180,7 +180,8 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
 
   // Synthesis (Algorithm 4), V_{T_d} -> V_0, one padded step at a time back to the host.
   Policy policy = empty_policy(a, device.label());
-  unpad(policy, a.horizon, buffers.padded_index, buffers.terminal.data());
+  unpad(policy.values.data() + std::size_t(a.horizon) * a.states.size(), buffers.padded_index,
+        buffers.terminal.data());
   std::vector<double> step_values(layout.padded_size);
   const double multiply_adds_per_step =
       double(buffers.free_states) * double(plan.records_per_state) * contraction_multiply_adds(a);
@@ -189,15 +190,37 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   const double record_bytes_per_step =
       plan.on_the_fly ? 0.0 : double(buffers.free_states) * double(plan.records_per_state) * double(layout.record_bytes());
   const double bytes_per_step = 8.0 * multiply_adds_per_step + record_bytes_per_step + 12.0 * double(a.states.size());
-  const auto synthesis_start = Clock::now();
   int current = 0;
+  // One Bellman step from values[current] (uploaded from host_in unless it is null: the previous
+  // step's output is already there) into values[1 - current], unpadded into host_out.
+  std::vector<double> padded_in(layout.padded_size, 0.0);
+  auto bellman = [&](const double* host_in, double* host_out, std::uint32_t* chosen) {
+    if (host_in) {
+      for (std::size_t x = 0; x < buffers.padded_index.size(); ++x) padded_in[buffers.padded_index[x]] = host_in[x];
+      check(clEnqueueWriteBuffer(session.queue.get(), buffers.values[current].get(), CL_TRUE, 0,
+                                 padded_in.size() * sizeof(double), padded_in.data(), 0, nullptr, nullptr),
+            "clEnqueueWriteBuffer");
+    }
+    sweep_step(session.queue.get(), sweep.get(), plan, buffers, current, chosen, step_values);
+    current = 1 - current;
+    unpad(host_out, buffers.padded_index, step_values.data());
+  };
+  if (a.unbounded) {
+    // Masses stored as float: values differ from the double ones by up to about 1e-7.
+    constexpr double kFloatMassResolution = 1e-6;
+    FunctionStep step(bellman, multiply_adds_per_step, bytes_per_step, kFloatMassResolution);
+    ReferenceStep host(a);
+    UnboundedRun run{device.label(), [&](unsigned iterations, double) { report_progress(Phase::Synthesis, iterations, -1); }};
+    Policy stationary = solve_unbounded(a, step, host, run, rep);
+    rep.host_peak_bytes = peak_resident_bytes();
+    return stationary;
+  }
+  const auto synthesis_start = Clock::now();
   for (unsigned step = a.horizon; step-- > 0;) {
     phase_start = Clock::now();
-    sweep_step(session.queue.get(), sweep.get(), plan, buffers, current,
-               policy.input_index.data() + std::size_t(step) * a.states.size(), step_values);
-    current = 1 - current;
+    bellman(nullptr, policy.values.data() + std::size_t(step) * a.states.size(),
+            policy.input_index.data() + std::size_t(step) * a.states.size());
     const double seconds = seconds_since(phase_start);
-    unpad(policy, step, buffers.padded_index, step_values.data());
     rep.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
                           multiply_adds_per_step, bytes_per_step});
     const unsigned done = a.horizon - step;

@@ -39,6 +39,7 @@ LookupStatus Policy::lookup(const double* state, std::size_t state_length, unsig
   if (state_length != states.dims()) return LookupStatus::WrongDimension;
   for (std::size_t i = 0; i < state_length; ++i)
     if (!std::isfinite(state[i])) return LookupStatus::NotFinite;
+  if (stationary) step = 0;
   if (step >= horizon) return LookupStatus::StepBeyondHorizon;
   const auto cell = states.cell_of(state);
   if (!cell) return LookupStatus::OutsideGrid;

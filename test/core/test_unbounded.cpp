@@ -1,0 +1,185 @@
+// Unbounded specifications (spec.horizon: infinite): interval iteration against closed forms,
+// with and without end components, on the reference engine and both OpenCL sweeps.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
+
+namespace amytiss {
+namespace {
+
+constexpr double kTolerance = 1e-6;
+// The dense sweep's masses are float (docs/engine.md): its bounds agree to this.
+constexpr double kOpenClTolerance = 1e-5;
+constexpr double kRounding = 1e-12;
+
+Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+
+Policy run(const Abstraction& a, DeviceKind device, SweepChoice sweep, SynthesisReport* report) {
+  SynthesisOptions options;
+  options.compute.device = device;
+  options.compute.sweep = sweep;
+  return synthesize(a, options, report);
+}
+
+bool note_contains(const SynthesisReport& report, const std::string& text) {
+  for (const auto& note : report.notes)
+    if (note.text.find(text) != std::string::npos) return true;
+  return false;
+}
+
+// Checks the bounds against the exact value: lower <= value <= upper within rounding (reference)
+// or the device's precision, and upper - lower <= tolerance.
+void expect_bounds(const Policy& policy, const std::vector<double>& exact, double slack, const std::string& what) {
+  ASSERT_TRUE(policy.stationary);
+  ASSERT_EQ(policy.upper_values.size(), exact.size());
+  double worst_gap = 0, worst_error = 0;
+  for (std::size_t x = 0; x < exact.size(); ++x) {
+    const double lower = policy.value(0, x), upper = policy.upper_values[x];
+    EXPECT_LE(lower, exact[x] + slack) << what << " cell " << x;
+    EXPECT_GE(upper, exact[x] - slack) << what << " cell " << x;
+    worst_gap = std::max(worst_gap, upper - lower);
+    worst_error = std::max(worst_error, std::fabs(lower - exact[x]));
+  }
+  EXPECT_LE(worst_gap, kTolerance + slack) << what;
+  EXPECT_LE(policy.gap, kTolerance + slack) << what;
+  std::printf("%s: %u iterations, gap %.3g, max |lower - exact| %.3g\n", what.c_str(), policy.iterations, policy.gap,
+              worst_error);
+}
+
+// Gambler's ruin: a lazy symmetric walk (uniform noise on [-1.5, 1.5]: one cell down, stay, up,
+// each 1/3) on 0..10 reaches 10 before 0 with probability x/10.
+const char* const kRuin =
+    "name: ruin\n"
+    "states: {lb: [0], ub: [10], eta: [1]}\n"
+    "dynamics: [\"x0\"]\n"
+    "noise: {distribution: uniform, half_width: [1.5]}\n"
+    "spec: {type: reach_avoid, horizon: infinite, target: {lb: [10], ub: [10]}, avoid: {lb: [0], ub: [0]}}\n";
+
+std::vector<double> ruin_value() {
+  std::vector<double> value(11);
+  for (int x = 0; x <= 10; ++x) value[x] = x / 10.0;
+  return value;
+}
+
+// A parking end component: below 6, input 0 parks the walk in {2, 3, 4} forever (value 0 if kept),
+// input 1 gambles (one third into the target, the rest off the grid); above 5 input 0 walks. The
+// value is 1/3 up to 5 and rises linearly (harmonic walk) to 1 at 10. Without the end-component
+// correction the upper bound would stay at 1 on {2, 3, 4}.
+const char* const kParking =
+    "name: parking\n"
+    "states: {lb: [0], ub: [10], eta: [1]}\n"
+    "inputs: {lb: [0], ub: [1], eta: [1]}\n"
+    "dynamics: [\"u0 > 0.5 ? 11 : (x0 <= 5 ? 3 : x0)\"]\n"
+    "noise: {distribution: uniform, half_width: [1.5]}\n"
+    "spec: {type: reach_avoid, horizon: infinite, target: {lb: [10], ub: [10]}, avoid: {lb: [0], ub: [0]}}\n";
+
+std::vector<double> parking_value() {
+  std::vector<double> value(11);
+  for (int x = 1; x <= 10; ++x) value[x] = x <= 5 ? 1.0 / 3 : 1.0 / 3 + 2.0 * (x - 5) / 15;
+  value[0] = 0;
+  value[10] = 1;
+  return value;
+}
+
+// Safety with a sure way to stay: pushing towards the centre keeps the walk in [1, 9] forever.
+const char* const kSureSafety =
+    "name: sure_safety\n"
+    "states: {lb: [0], ub: [10], eta: [1]}\n"
+    "inputs: {lb: [-1], ub: [1], eta: [1]}\n"
+    "dynamics: [\"x0 + u0\"]\n"
+    "noise: {distribution: uniform, half_width: [1.5]}\n"
+    "spec: {type: safety, horizon: infinite, safe: {lb: [1], ub: [9]}}\n";
+
+TEST(Unbounded, GamblersRuinClosedForm) {
+  const Abstraction a = from_yaml(kRuin);
+  SynthesisReport report;
+  expect_bounds(run(a, DeviceKind::Reference, SweepChoice::Auto, &report), ruin_value(), kRounding, "ruin reference");
+  EXPECT_TRUE(note_contains(report, "no end components"));
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Dense, nullptr), ruin_value(), kOpenClTolerance, "ruin dense");
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Factored, nullptr), ruin_value(), kRounding, "ruin factored");
+}
+
+TEST(Unbounded, EndComponentIsCorrected) {
+  const Abstraction a = from_yaml(kParking);
+  SynthesisReport report;
+  const Policy policy = run(a, DeviceKind::Reference, SweepChoice::Auto, &report);
+  expect_bounds(policy, parking_value(), kRounding, "parking reference");
+  EXPECT_TRUE(note_contains(report, "cells in end components"));
+  // The stored policy gambles in the parking cells (parking forever is worth 0).
+  for (std::size_t x = 2; x <= 4; ++x) EXPECT_EQ(policy.input(0, x), 1u) << x;
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Dense, nullptr), parking_value(), kOpenClTolerance,
+                "parking dense");
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Factored, nullptr), parking_value(), kRounding,
+                "parking factored");
+}
+
+TEST(Unbounded, SureSafetyIsOne) {
+  const Abstraction a = from_yaml(kSureSafety);
+  std::vector<double> exact(11, 1.0);
+  exact[0] = exact[10] = 0.0;
+  expect_bounds(run(a, DeviceKind::Reference, SweepChoice::Auto, nullptr), exact, kRounding, "sure safety reference");
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Dense, nullptr), exact, kOpenClTolerance, "sure safety dense");
+}
+
+// Safety against a disturbance that pushes right at the edge: below 10 the controller keeps the walk
+// in [1, 9] surely; at 10 and 11 the disturbance cancels its push, so V(10) = (1 + V(10) + V(11))/3
+// and V(11) = (V(10) + V(11) + 0)/3: V(10) = 2/3, V(11) = 1/3.
+TEST(Unbounded, SafetyWithDisturbanceClosedForm) {
+  const Abstraction a = from_yaml(
+      "name: safety_disturbance\n"
+      "states: {lb: [0], ub: [12], eta: [1]}\n"
+      "inputs: {lb: [-1], ub: [1], eta: [1]}\n"
+      "disturbances: {lb: [0], ub: [1], eta: [1]}\n"
+      "dynamics: [\"x0 + u0 + w0*(x0 > 9 ? 1 : 0)\"]\n"
+      "noise: {distribution: uniform, half_width: [1.5]}\n"
+      "spec: {type: safety, horizon: infinite, safe: {lb: [1], ub: [11]}}\n");
+  std::vector<double> exact(13, 1.0);
+  exact[0] = exact[12] = 0.0;
+  exact[10] = 2.0 / 3;
+  exact[11] = 1.0 / 3;
+  expect_bounds(run(a, DeviceKind::Reference, SweepChoice::Auto, nullptr), exact, kRounding, "safety reference");
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Dense, nullptr), exact, kOpenClTolerance, "safety dense");
+  expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Factored, nullptr), exact, kRounding, "safety factored");
+}
+
+TEST(Unbounded, ConfigurationKeys) {
+  const Config config = config_from_yaml(YAML::Load(kRuin));
+  EXPECT_TRUE(config.spec.unbounded);
+  EXPECT_EQ(config.spec.tolerance, 1e-6);
+  EXPECT_EQ(config_from_yaml(YAML::Load(to_yaml(config))).spec.unbounded, true);
+  auto error_key = [](const std::string& text) {
+    try {
+      config_from_yaml(YAML::Load(text));
+    } catch (const ConfigError& error) {
+      return error.key();
+    }
+    return std::string("none");
+  };
+  std::string text = kRuin;
+  EXPECT_EQ(error_key(text.substr(0, text.find("spec:")) +
+                      "spec: {type: safety, horizon: 5, tolerance: 1.0e-3}\n"),
+            "spec.tolerance");
+  EXPECT_EQ(error_key(text.substr(0, text.find("spec:")) +
+                      "spec: {type: safety, horizon: infinite, tolerance: 0}\n"),
+            "spec.tolerance");
+  EXPECT_EQ(error_key(text.substr(0, text.find("spec:")) + "spec: {type: safety, horizon: forever}\n"),
+            "spec.horizon");
+}
+
+TEST(Unbounded, StationaryLookupIgnoresTheStep) {
+  const Policy policy = run(from_yaml(kRuin), DeviceKind::Reference, SweepChoice::Auto, nullptr);
+  const double state[] = {3.0};
+  double input[1] = {0}, probability = -1;
+  EXPECT_EQ(policy.lookup(state, 1, 12345, input, &probability), LookupStatus::Ok);
+  EXPECT_NEAR(probability, 0.3, kTolerance);
+}
+
+}  // namespace
+}  // namespace amytiss
