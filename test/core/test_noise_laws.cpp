@@ -256,6 +256,19 @@ TEST(NoiseLaws, ConfigurationErrorsNameTheKey) {
       "spec: {type: safety, horizon: 1}\n")));
 }
 
+TEST(NoiseLaws, CanonicalYamlRoundTrips) {
+  for (const std::string& noise :
+       {std::string("distribution: exponential, rate: [2.0, 0.7], shift: [-0.5, 0.25]"),
+        std::string("distribution: beta, alpha: [2, 0.5], beta: [5, 0.5], support: {lb: [-1, 0], ub: [1, 3]}"),
+        std::string("distribution: custom, density: [\"0.5*exp(-abs(z))\", \"exp(-z)\"], "
+                    "support: {lb: [-40, 0], ub: [40, 40]}")}) {
+    const Config config = config_from_yaml(YAML::Load(law_yaml(noise)));
+    const Config again = config_from_yaml(YAML::Load(to_yaml(config)));
+    EXPECT_EQ(to_yaml(again), to_yaml(config)) << noise;
+    EXPECT_EQ(config_hash(again), config_hash(config)) << noise;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Engines: the reference against the OpenCL engine, whose factored sweep takes the host's masses.
 
