@@ -34,6 +34,21 @@ std::vector<VariableUse> expression_uses(const std::vector<Expression>& expressi
   return uses;
 }
 
+void evaluate_expressions(const std::vector<Expression>& expressions, const double* x, const double* u,
+                          const double* w, double* out) {
+  for (std::size_t i = 0; i < expressions.size(); ++i) out[i] = expressions[i].evaluate(x, u, w);
+}
+
+/// "void <function>(const double* x, const double* u, const double* w, double* <out>)" in OpenCL C.
+std::string expressions_source(const std::vector<Expression>& expressions, const std::string& function,
+                               const std::string& out) {
+  std::string source = "void " + function + "(const double* x, const double* u, const double* w, double* " + out +
+                       ") {\n  (void)u;\n  (void)w;\n";
+  for (std::size_t i = 0; i < expressions.size(); ++i)
+    source += "  " + out + "[" + std::to_string(i) + "] = " + expressions[i].to_c() + ";\n";
+  return source + "}\n";
+}
+
 /// `dynamics` without an integrator: the expressions are the discrete map.
 class ExpressionDynamics : public Dynamics {
  public:
@@ -45,17 +60,10 @@ class ExpressionDynamics : public Dynamics {
   std::size_t disturbance_dims() const override { return disturbance_dims_; }
 
   void evaluate(const double* x, const double* u, const double* w, double* post) const override {
-    for (std::size_t i = 0; i < expressions_.size(); ++i) post[i] = expressions_[i].evaluate(x, u, w);
+    evaluate_expressions(expressions_, x, u, w, post);
   }
 
-  std::string opencl_source() const override {
-    std::string source =
-        "void amytiss_dynamics(const double* x, const double* u, const double* w, double* post) {\n"
-        "  (void)u;\n  (void)w;\n";
-    for (std::size_t i = 0; i < expressions_.size(); ++i)
-      source += "  post[" + std::to_string(i) + "] = " + expressions_[i].to_c() + ";\n";
-    return source + "}\n";
-  }
+  std::string opencl_source() const override { return expressions_source(expressions_, "amytiss_dynamics", "post"); }
 
   std::string describe() const override { return "expressions (" + std::to_string(expressions_.size()) + ")"; }
 
@@ -77,16 +85,11 @@ class ExpressionField : public VectorField {
   std::size_t disturbance_dims() const override { return disturbance_dims_; }
 
   void rate(const double* x, const double* u, const double* w, double* rate) const override {
-    for (std::size_t i = 0; i < expressions_.size(); ++i) rate[i] = expressions_[i].evaluate(x, u, w);
+    evaluate_expressions(expressions_, x, u, w, rate);
   }
 
   std::string opencl_source() const override {
-    std::string source =
-        "void amytiss_vector_field(const double* x, const double* u, const double* w, double* rate) {\n"
-        "  (void)u;\n  (void)w;\n";
-    for (std::size_t i = 0; i < expressions_.size(); ++i)
-      source += "  rate[" + std::to_string(i) + "] = " + expressions_[i].to_c() + ";\n";
-    return source + "}\n";
+    return expressions_source(expressions_, "amytiss_vector_field", "rate");
   }
 
   std::string describe() const override { return "expressions dx/dt (" + std::to_string(expressions_.size()) + ")"; }
