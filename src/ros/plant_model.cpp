@@ -81,6 +81,17 @@ std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const st
   return text;
 }
 
+std::string consistency_text(unsigned successes, unsigned episodes, double predicted) {
+  constexpr double kStandardErrors = 4.0;
+  const double rate = episodes ? double(successes) / episodes : 0.0;
+  const double bound = episodes ? kStandardErrors * std::sqrt(predicted * (1 - predicted) / episodes) : 0.0;
+  const double difference = std::abs(rate - predicted);
+  char text[200];
+  std::snprintf(text, sizeof text, "|rate - V_0| = %.4f, 4 standard errors of V_0 over %u episodes = %.4f: %s",
+                difference, episodes, bound, difference <= bound ? "consistent" : "NOT consistent");
+  return text;
+}
+
 EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step) {
   const std::string at = " at step " + std::to_string(step);
   const bool safety = spec == amytiss::SpecType::Safety;

@@ -50,6 +50,11 @@ std::optional<amytiss::VehicleOutline> vehicle_outline(const amytiss::Config& co
 std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const std::vector<double>& first,
                                 const std::vector<double>& last);
 
+/// "|rate - V_0| = 0.0014, 4 standard errors of V_0 over 20 episodes = 0.0334: consistent" (or
+/// "NOT consistent"): the empirical success rate against the prediction, with the binomial
+/// standard error sqrt(V_0 (1 - V_0) / episodes) of a rate whose true value is V_0.
+std::string consistency_text(unsigned successes, unsigned episodes, double predicted);
+
 /// Outcome of an episode that ended at `step` in a state of class `state_class` (for Free: the
 /// horizon is over). Reach specs succeed on Target; safety succeeds when the horizon is over.
 EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step);

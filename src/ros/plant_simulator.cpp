@@ -222,6 +222,7 @@ int PlantSimulatorNode::run() {
   ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); predicted V_0 at the "
            "start state = %.4f",
            summary.successes, summary.episodes, summary.success_rate, standard_error, predicted);
+  ROS_INFO("plant simulator: %s", consistency_text(summary.successes, summary.episodes, predicted).c_str());
 
   if (!plot_script.empty()) {
     summary.trajectories_png = base + "_trajectories.png";

@@ -314,6 +314,14 @@ TEST(Outcomes, TextsPerSpecification) {
   EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Free, 8).success);
 }
 
+TEST(Outcomes, ConsistencyOfTheRateWithV0) {
+  // V_0 0.9986 over 20 episodes: standard error sqrt(0.9986 * 0.0014 / 20) = 0.00836.
+  EXPECT_EQ(amytiss_ros::consistency_text(20, 20, 0.9986),
+            "|rate - V_0| = 0.0014, 4 standard errors of V_0 over 20 episodes = 0.0334: consistent");
+  EXPECT_EQ(amytiss_ros::consistency_text(15, 20, 0.9986),
+            "|rate - V_0| = 0.2486, 4 standard errors of V_0 over 20 episodes = 0.0334: NOT consistent");
+}
+
 TEST(Outcomes, ClassifyByCellRole) {
   const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
   amytiss::Policy policy;
