@@ -191,6 +191,27 @@ TEST(Integrator, KinematicModelAgreesWithAFineIndependentIntegration) {
   EXPECT_GT(worst_euler, 100 * kFineVsModelTolerance);  // why the parking example integrates with RK4
 }
 
+TEST(Integrator, Vehicle3dAgreesWithAFineIndependentIntegration) {
+  const auto model = make_dynamics(config_of("model: vehicle3d", 3, 2, "{method: rk4, substeps: 4}"));
+  std::mt19937 generator(4);
+  std::uniform_real_distribution<double> position(-5, 5), heading(-3.1, 3.1), speed(-1, 2), steering(-0.5, 0.5);
+  double worst = 0;
+  for (int sample = 0; sample < 100; ++sample) {
+    const std::vector<double> x = {position(generator), position(generator), heading(generator)};
+    const std::vector<double> u = {speed(generator), steering(generator)};
+    // Reissig et al. 2016, section IX-A, written here again.
+    const double alpha = std::atan(std::tan(u[1]) / 2);
+    const Rate rate = [&](const double* state, double* out) {
+      out[0] = u[0] * std::cos(alpha + state[2]) / std::cos(alpha);
+      out[1] = u[0] * std::sin(alpha + state[2]) / std::cos(alpha);
+      out[2] = u[0] * std::tan(u[1]);
+    };
+    worst = std::max(worst, max_difference(step(*model, x, u), fine_rk4(rate, x, 0.3, kFineSubsteps)));
+  }
+  std::printf("vehicle3d, 0.3 s step: max |error| rk4 x4 %.3g (against rk4 x%d)\n", worst, kFineSubsteps);
+  EXPECT_LE(worst, kFineVsModelTolerance);
+}
+
 TEST(Integrator, SingleTrackModelAgreesWithAFineIntegrationOfItsVectorField) {
   // Stiff at low speed (rates of about -216/v per second): RK4 is stable for h < 2.78/216 s at 1 m/s.
   const Config config = config_of("model: bmw320i", 7, 2, "{method: rk4, substeps: 10}");
