@@ -68,10 +68,15 @@ struct SpecConfig {
 
 enum class DeviceKind { Auto, Cpu, Gpu, Reference };
 enum class TransitionStorage { Auto, Stored, OnTheFly };
+/// How the OpenCL engine computes the expected next values (docs/engine.md, "Two sweeps").
+enum class SweepChoice { Auto, Dense, Factored };
 
 struct ComputeConfig {
   DeviceKind device = DeviceKind::Auto;
   TransitionStorage transitions = TransitionStorage::Auto;
+  /// auto: the factored sweep where the dynamics allow it and it saves at least half the
+  /// multiply-adds, else dense; dense / factored: that one (factored that cannot run: error).
+  SweepChoice sweep = SweepChoice::Auto;
   /// Optional OpenCL platform/device selection: a 0-based index ("1") or a case-insensitive
   /// substring of the platform or device name ("nvidia"). Empty: any.
   std::string platform;
@@ -117,6 +122,7 @@ std::string config_hash(const Config& config);
 std::string to_string(SpecType);
 std::string to_string(DeviceKind);
 std::string to_string(TransitionStorage);
+std::string to_string(SweepChoice);
 std::string to_string(NoiseType);
 std::string to_string(Distribution);
 std::string to_string(Truncation);

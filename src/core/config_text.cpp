@@ -70,6 +70,7 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
     text += "compute:\n";
     text += "  device: " + to_string(compute.device) + "\n";
     text += "  transitions: " + to_string(compute.transitions) + "\n";
+    text += "  sweep: " + to_string(compute.sweep) + "\n";
     text += "  platform: " + quoted(compute.platform) + "\n";
     text += "  device_name: " + quoted(compute.device_name) + "\n";
     text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";

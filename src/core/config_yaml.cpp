@@ -184,11 +184,13 @@ Config config_from_yaml(const YAML::Node& root) {
 
   if (present(root["compute"])) {
     const YAML::Node compute = root["compute"];
-    check_keys(compute, "compute", {"device", "transitions", "platform", "device_name", "memory_fraction"},
+    check_keys(compute, "compute", {"device", "transitions", "sweep", "platform", "device_name", "memory_fraction"},
                "compute: {device: auto}");
     if (present(compute["device"]))
       config.compute.device = read_enum<DeviceKind>(
           compute["device"], "compute.device", "device: auto");
+    if (present(compute["sweep"]))
+      config.compute.sweep = read_enum<SweepChoice>(compute["sweep"], "compute.sweep", "sweep: auto");
     if (present(compute["transitions"]))
       config.compute.transitions = read_enum<TransitionStorage>(
           compute["transitions"], "compute.transitions", "transitions: auto");

@@ -21,6 +21,12 @@ const std::vector<std::pair<const char*, TransitionStorage>>& enum_names() {
   return names;
 }
 template <>
+const std::vector<std::pair<const char*, SweepChoice>>& enum_names() {
+  static const std::vector<std::pair<const char*, SweepChoice>> names = {
+      {"auto", SweepChoice::Auto}, {"dense", SweepChoice::Dense}, {"factored", SweepChoice::Factored}};
+  return names;
+}
+template <>
 const std::vector<std::pair<const char*, NoiseType>>& enum_names() {
   static const std::vector<std::pair<const char*, NoiseType>> names = {{"additive", NoiseType::Additive},
                                                                        {"multiplicative", NoiseType::Multiplicative}};
@@ -79,6 +85,7 @@ std::string name_of(Enum value) {
 std::string to_string(SpecType value) { return name_of(value); }
 std::string to_string(DeviceKind value) { return name_of(value); }
 std::string to_string(TransitionStorage value) { return name_of(value); }
+std::string to_string(SweepChoice value) { return name_of(value); }
 std::string to_string(NoiseType value) { return name_of(value); }
 std::string to_string(Distribution value) { return name_of(value); }
 std::string to_string(Truncation value) { return name_of(value); }

@@ -57,6 +57,8 @@ struct DeviceInfo {
   cl_uint compute_units = 0;
   std::size_t max_work_group = 1;
   bool fp64 = false;
+  cl_uint native_double_width = 1;  ///< CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE: 1 on SIMT GPUs
+  cl_uint max_clock_mhz = 0;        ///< CL_DEVICE_MAX_CLOCK_FREQUENCY
   bool is_gpu() const { return (type & CL_DEVICE_TYPE_GPU) != 0; }
   bool is_cpu() const { return (type & CL_DEVICE_TYPE_CPU) != 0; }
   std::string label() const { return platform_name + " / " + device_name; }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
 
 namespace amytiss::detail {
@@ -63,18 +64,19 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
       rep.transitions = "on_the_fly (requested; " + estimate + ")";
       break;
     case TransitionStorage::Stored:
-      plan.on_the_fly = !fits;
-      rep.transitions = fits ? "stored (requested; " + estimate + ")"
-                             : "on_the_fly (stored requested but does not fit: " + estimate + ")";
+      // An explicit request is honoured or refused, never silently replaced.
+      if (!fits)
+        throw DeviceError("compute.transitions stored was requested but the records do not fit on " +
+                          device.label() + ": " + estimate +
+                          "; use transitions: auto or on_the_fly, or a larger compute.memory_fraction");
+      rep.transitions = "stored (requested; " + estimate + ")";
       break;
     default:
       plan.on_the_fly = !fits;
       rep.transitions = (fits ? "stored (auto: " : "on_the_fly (auto: ") + estimate + ")";
       break;
   }
-  const bool storage_differs = options.compute.transitions == TransitionStorage::Stored && !fits;
-  rep.notes.push_back({storage_differs ? NoteSeverity::Warning : NoteSeverity::Info, NoteKind::Transitions,
-                       "transitions: " + rep.transitions});
+  rep.notes.push_back({NoteSeverity::Info, NoteKind::Transitions, "transitions: " + rep.transitions});
 
   plan.variant = engine_options.variant;
   if (plan.variant == SweepVariant::Auto)
