@@ -306,8 +306,9 @@ TEST(Integrator, DependenciesHoldForTheIntegratedModels) {
           for (std::size_t i = 0; i < n; ++i) {
             const auto& listed = j < n ? (*uses)[i].states : (*uses)[i].inputs;
             const std::size_t index = j < n ? j : j - n;
-            if (std::find(listed.begin(), listed.end(), index) == listed.end())
+            if (std::find(listed.begin(), listed.end(), index) == listed.end()) {
               EXPECT_EQ(moved[i], base[i]) << "post " << i << " changed with component " << j;
+            }
           }
         }
       }
