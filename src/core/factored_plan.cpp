@@ -197,6 +197,12 @@ std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
     for (std::size_t v : reads[dim])
       if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
         stage.output.push_back({false, v, variables[v].count});
+    // Q: input and disturbance digits last, so that the input choice reads each state's values
+    // from one stretch of memory.
+    if (k + 1 == order.size())
+      std::stable_partition(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
+        return variables[digit.id].space == FactorVariable::Space::State;
+      });
     // The next stage's contracted cell goes just before its vector digit: each work-item's
     // window is then one contiguous block of the next input.
     if (k + 1 < order.size()) {
