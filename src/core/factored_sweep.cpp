@@ -11,6 +11,7 @@
 #include "factored_tables.hpp"
 #include "interval_iteration.hpp"
 #include "opencl_program_cache.hpp"
+#include "opencl_run.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -58,12 +59,9 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   Program program = build_program(run.context, *run.device, factored_program_source(a, plan, shape),
                                   run.kernel_cache_dir, report.notes);
   std::vector<Kernel> stage_kernels;
-  for (std::size_t k = 0; k < plan.stages.size(); ++k) {
-    stage_kernels.emplace_back(clCreateKernel(program.get(), ("stage" + std::to_string(k)).c_str(), &error));
-    check(error, "clCreateKernel(stage)");
-  }
-  Kernel choose(clCreateKernel(program.get(), "choose_inputs", &error));
-  check(error, "clCreateKernel(choose_inputs)");
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    stage_kernels.push_back(create_kernel(program.get(), ("stage" + std::to_string(k)).c_str()));
+  const Kernel choose = create_kernel(program.get(), "choose_inputs");
   report.phases.push_back({"kernel build", seconds_since(phase_start), 0, 0});
   if (run.progress) run.progress(Phase::Setup, 0, -1);
 
@@ -131,15 +129,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   };
 
   // --- synthesis, V_{T_d} -> V_0
-  Policy policy;
-  policy.states = a.states;
-  policy.inputs = a.inputs;
-  policy.horizon = a.horizon;
-  policy.roles = a.roles;
-  policy.computed_by = run.device->label();
-  policy.config_hash = config_hash(a.config);
-  policy.values.assign((std::size_t(a.horizon) + 1) * n_states, 0.0);
-  policy.input_index.assign(std::size_t(a.horizon) * n_states, 0);
+  Policy policy = empty_policy(a, run.device->label());
   std::copy(terminal.begin(), terminal.begin() + std::ptrdiff_t(n_states),
             policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
 
