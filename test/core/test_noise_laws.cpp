@@ -14,6 +14,7 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
 #include "agreement.hpp"
+#include "monte_carlo.hpp"
 #include "noise_laws.hpp"
 #include "test_support.hpp"
 
@@ -343,56 +344,14 @@ TEST(NoiseLawsMonteCarlo, ExponentialSuccessRateMatchesValue) {
       "spec: {type: reach_avoid, horizon: 6, target: {lb: [1.5, 1.5], ub: [2.5, 2.5]}, "
       "avoid: {lb: [-0.5, -0.5], ub: [0.5, 0.5]}}\n");
   const Policy policy = synthesize_reference(a, nullptr);
-  const Grid& states = a.states;
-  auto worst_row = [&](std::size_t cell, unsigned step) {
-    const auto x = states.point(cell), u = a.inputs.point(policy.input(step, cell));
-    std::vector<double> worst_row;
-    double worst = std::numeric_limits<double>::infinity();
-    for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
-      const auto disturbance = a.disturbances.point(w);
-      double mean[2];
-      a.dynamics->evaluate(x.data(), u.data(), disturbance.data(), mean);
-      std::vector<double> row(states.size());
-      double expected = 0;
-      for (std::size_t target = 0; target < states.size(); ++target) {
-        row[target] = a.noise->transition_probability(states, target, mean, x.data());
-        expected += row[target] * policy.value(step + 1, target);
-      }
-      if (expected < worst) worst = expected, worst_row = row;
-    }
-    return worst_row;
-  };
-  std::vector<std::vector<double>> rows(std::size_t(policy.horizon) * states.size());
+  test_support::AbstractMdpSimulator simulator(a, policy);
   std::mt19937_64 generator(11);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   constexpr int kRuns = 20000;
   int checked_nontrivial = 0;
   for (const std::vector<double>& start : {std::vector<double>{-2.5, -2.5}, {-2.0, 1.0}, {2.5, -1.0}, {0.0, 2.5}}) {
-    const std::size_t start_cell = *states.cell_of(start.data());
+    const std::size_t start_cell = *a.states.cell_of(start.data());
     const double predicted = policy.value(0, start_cell);
-    int successes = 0;
-    for (int run = 0; run < kRuns; ++run) {
-      std::size_t cell = start_cell;
-      for (unsigned step = 0; step < policy.horizon; ++step) {
-        auto& row = rows[std::size_t(step) * states.size() + cell];
-        if (row.empty()) row = worst_row(cell, step);
-        // The row's missing mass (off the grid, cut) is failure.
-        double draw = uniform(generator), cumulative = 0;
-        std::size_t next = states.size();
-        for (std::size_t target = 0; target < states.size() && next == states.size(); ++target) {
-          cumulative += row[target];
-          if (draw < cumulative) next = target;
-        }
-        if (next == states.size()) break;
-        cell = next;
-        if (a.roles[cell] == CellRole::FixedOne) {
-          ++successes;
-          break;
-        }
-        if (a.roles[cell] == CellRole::FixedZero) break;
-      }
-    }
-    const double rate = double(successes) / kRuns;
+    const double rate = simulator.success_rate(start_cell, kRuns, generator);
     const double standard_error = std::sqrt(std::max(predicted * (1 - predicted), 1e-4) / kRuns);
     EXPECT_NEAR(rate, predicted, kMonteCarloStandardErrors * standard_error) << start[0] << ", " << start[1];
     std::printf("exponential monte carlo from (%g, %g): V_0 = %.4f, success rate %.4f over %d runs (4 SE = %.4f)\n",

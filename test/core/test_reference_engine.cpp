@@ -8,6 +8,7 @@
 
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
+#include "monte_carlo.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -266,31 +267,8 @@ TEST(ReferenceEngineMonteCarlo, SuccessRateMatchesValue) {
       dynamics);
   const Policy policy = synthesize_reference(abstraction, nullptr);
   const Grid& states = abstraction.states;
-  const std::size_t W = abstraction.disturbances.size();
-
-  // Row of the chosen input under the worst disturbance, for (cell, step).
-  auto worst_row = [&](std::size_t cell, unsigned step) {
-    const auto x = states.point(cell), u = abstraction.inputs.point(policy.input(step, cell));
-    std::vector<double> best_row;
-    double worst = std::numeric_limits<double>::infinity();
-    for (std::size_t w = 0; w < W; ++w) {
-      const auto disturbance = abstraction.disturbances.point(w);
-      double mean[2];
-      abstraction.dynamics->evaluate(x.data(), u.data(), disturbance.data(), mean);
-      std::vector<double> row(states.size());
-      double expected = 0;
-      for (std::size_t target = 0; target < states.size(); ++target) {
-        row[target] = abstraction.noise->transition_probability(states, target, mean, x.data());
-        expected += row[target] * policy.value(step + 1, target);
-      }
-      if (expected < worst) worst = expected, best_row = row;
-    }
-    return best_row;
-  };
-  std::vector<std::vector<double>> rows(std::size_t(policy.horizon) * states.size());
-
+  AbstractMdpSimulator simulator(abstraction, policy);
   std::mt19937_64 generator(42);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   constexpr int kRuns = 20000;
   const std::vector<std::vector<double>> starts{{-2.5, -2.5}, {-2.5, 2.0}, {0.0, 2.0}, {2.5, -1.0}};
   int checked_nontrivial = 0;
@@ -298,34 +276,7 @@ TEST(ReferenceEngineMonteCarlo, SuccessRateMatchesValue) {
     const std::size_t start_cell = *states.cell_of(start.data());
     ASSERT_EQ(abstraction.roles[start_cell], CellRole::Free);
     const double predicted = policy.value(0, start_cell);
-    int successes = 0;
-    for (int run = 0; run < kRuns; ++run) {
-      std::size_t cell = start_cell;
-      bool success = false;
-      for (unsigned step = 0; step < policy.horizon; ++step) {
-        auto& row = rows[std::size_t(step) * states.size() + cell];
-        if (row.empty()) row = worst_row(cell, step);
-        // Sample the next cell; the row's missing mass (off grid, cut) is failure.
-        double draw = uniform(generator), cumulative = 0;
-        std::size_t next = states.size();
-        for (std::size_t target = 0; target < states.size(); ++target) {
-          cumulative += row[target];
-          if (draw < cumulative) {
-            next = target;
-            break;
-          }
-        }
-        if (next == states.size()) break;
-        cell = next;
-        if (abstraction.roles[cell] == CellRole::FixedOne) {
-          success = true;
-          break;
-        }
-        if (abstraction.roles[cell] == CellRole::FixedZero) break;
-      }
-      successes += success;
-    }
-    const double rate = double(successes) / kRuns;
+    const double rate = simulator.success_rate(start_cell, kRuns, generator);
     const double standard_error = std::sqrt(std::max(predicted * (1 - predicted), 1e-4) / kRuns);
     EXPECT_NEAR(rate, predicted, kMonteCarloStandardErrors * standard_error)
         << "start (" << start[0] << ", " << start[1] << ")";
