@@ -183,6 +183,13 @@ void print_error_budget(const Abstraction& abstraction) {
 
 bool print_progress(const Progress& progress, bool quiet) {
   if (quiet || progress.phase != Phase::Synthesis) return true;
+  if (progress.steps_total == 0) {  // unbounded: interval iterations, no fixed count; every 100th
+    if (progress.steps_done % 100 != 0) return true;
+    std::printf("  iteration %u on %s, elapsed %s\n", progress.steps_done, progress.device.c_str(),
+                format_seconds(progress.elapsed_s).c_str());
+    std::fflush(stdout);
+    return true;
+  }
   std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
               progress.steps_total, progress.percent(), progress.device.c_str(),
               format_seconds(progress.elapsed_s).c_str());
