@@ -301,15 +301,21 @@ std::string readme_text(const Abstraction& a, const ExportLayout& layout, Export
   s << "\nChoice u of a cell is the input with flat index u of the input grid. Cells with a fixed role and the "
     << "sink have one choice, a self-loop.\n\n## Labels and properties\n\n"
     << "`init`: every cell (any cell may be the start). ";
+  // The step bound of the property: none for an unbounded specification.
+  const std::string bound =
+      a.unbounded ? std::string() : "<=" + std::to_string(layout.adversary ? 2 * horizon : horizon);
+  const std::string which = a.unbounded ? "unbounded value" : "bounded-horizon value V_0";
   if (a.spec == SpecType::Safety)
-    s << "`unsafe`: the cells outside the safe set. The bounded-horizon value V_0 of amytiss is\n\n"
-      << "    Pmax=? [ G<=" << (layout.adversary ? 2 * horizon : horizon) << " !(\"unsafe\" | \"sink\") ]\n\n";
+    s << "`unsafe`: the cells outside the safe set. The " << which << " of amytiss is\n\n"
+      << "    Pmax=? [ G" << bound << " !(\"unsafe\" | \"sink\") ]\n\n";
   else
-    s << "`target`: the target cells; `avoid`: the cells to avoid. The bounded-horizon value V_0 of amytiss is\n\n"
-      << "    Pmax=? [ !(\"avoid\" | \"sink\") U<=" << (layout.adversary ? 2 * horizon : horizon) << " \"target\" ]\n\n";
-  s << "from each cell (horizon T = " << horizon << ", " << steps << " model steps), "
-    << (layout.adversary ? "with the adversary states minimizing. " : "")
-    << "Drop the bound (`G`, `U` without `<=`) for the unbounded value.\n\n"
+    s << "`target`: the target cells; `avoid`: the cells to avoid. The " << which << " of amytiss is\n\n"
+      << "    Pmax=? [ !(\"avoid\" | \"sink\") U" << bound << " \"target\" ]\n\n";
+  s << "from each cell";
+  if (!a.unbounded) s << " (horizon T = " << horizon << ", " << steps << " model steps)";
+  s << (layout.adversary ? ", with the adversary states minimizing. " : ". ")
+    << (a.unbounded ? "" : "Drop the bound (`G`, `U` without `<=`) for the unbounded value.")
+    << "\n\n"
     << "## Configuration\n\n```yaml\n" << to_yaml(a.config) << "```\n";
   return s.str();
 }
