@@ -264,6 +264,19 @@ void print_value_summary(const Policy& policy) {
   std::printf("V_0 over %zu free cells: min %.6f, mean %.6f, max %.6f; %zu cells with V_0 >= 0.5\n",
               summary.free_cells, summary.min, summary.mean, summary.max,
               summary.cells_at_least_half);
+  if (!policy.stationary) return;
+  // Unbounded: V_0 above is the certified lower bound; the upper bound and the gap beside it.
+  double upper_max = 0, upper_sum = 0;
+  std::size_t free_cells = 0;
+  for (std::size_t cell = 0; cell < policy.states.size(); ++cell) {
+    if (policy.roles[cell] != CellRole::Free) continue;
+    upper_max = std::max(upper_max, policy.upper_values[cell]);
+    upper_sum += policy.upper_values[cell];
+    ++free_cells;
+  }
+  std::printf("unbounded: V_0 is the stationary policy's certified lower bound; upper bound mean %.6f, max %.6f; "
+              "largest gap %.3g after %u interval iterations\n",
+              free_cells ? upper_sum / double(free_cells) : 0.0, upper_max, policy.gap, policy.iterations);
 }
 
 void compare_with_reference(const Abstraction& abstraction, const Policy& policy,
