@@ -81,7 +81,8 @@ TEST_F(CliTest, HelpListsEveryOption) {
   const CommandResult result = synth("--help");
   EXPECT_EQ(0, result.exit_code) << result.err;
   for (const char* option : {"--config", "--device", "--transitions", "--platform", "--output",
-                             "--profile", "--compare-reference", "--list-devices", "--quiet"})
+                             "--profile", "--compare-reference", "--list-devices", "--quiet", "--export",
+                             "--export-max-transitions"})
     EXPECT_CONTAINS(result.out, option);
 }
 
@@ -180,6 +181,29 @@ TEST_F(CliTest, BadOptionsExitTwo) {
   result = synth("--device reference");
   EXPECT_EQ(2, result.exit_code);
   EXPECT_CONTAINS(result.err, "--config FILE is required");
+}
+
+TEST_F(CliTest, ExportWritesTheModelOrRefusesItAboveTheLimit) {
+  CommandResult result = synth("--config " + quote(kTinyConfig) + " --export prism model");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  // 73 free cells x 9 inputs, 8 fixed cells and the sink with one choice each.
+  EXPECT_CONTAINS(result.out, "exported prism: 82 states, 666 choices");
+  for (const char* file : {"model/model.tra", "model/model.sta", "model/model.lab", "model/README.md"})
+    EXPECT_TRUE(fs::exists(path(file))) << file;
+  EXPECT_FALSE(fs::exists(path("cli_tiny.h5"))) << "an export does not synthesize";
+  result = synth("--config " + quote(kTinyConfig) + " --export drn drn");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_TRUE(fs::exists(path("drn/model.drn")));
+  result = synth("--config " + quote(kTinyConfig) + " --export drn small --export-max-transitions 100");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "more than the limit 100");
+  EXPECT_FALSE(fs::exists(path("small")));
+  result = synth("--config " + quote(kTinyConfig) + " --export json out");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "--export: got 'json', expected prism or drn");
+  result = synth("--config " + quote(kTinyConfig) + " --export prism out --export-max-transitions lots");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "--export-max-transitions: got 'lots'");
 }
 
 TEST_F(CliTest, UnwritableOutputExitsOne) {
