@@ -149,6 +149,35 @@ TEST(Unbounded, SafetyWithDisturbanceClosedForm) {
   expect_bounds(run(a, DeviceKind::Cpu, SweepChoice::Factored, nullptr), exact, kRounding, "safety factored");
 }
 
+// A 2-d reach-avoid robot with Gaussian noise and a disturbance: the engines' bounds agree.
+TEST(Unbounded, OpenClAgreesWithReferenceOnARobot) {
+  const Abstraction a = from_yaml(
+      "name: robot_unbounded\n"
+      "states: {lb: [-2, -2], ub: [2, 2], eta: [0.5, 0.5]}\n"
+      "inputs: {lb: [-1, -1], ub: [1, 1], eta: [1, 1]}\n"
+      "disturbances: {lb: [-0.1], ub: [0.1], eta: [0.2]}\n"
+      "dynamics: [\"x0 + 0.5*u0 + w0\", \"x1 + 0.5*u1\"]\n"
+      "noise: {covariance: [0.04, 0.04], truncation: cutting_probability, cutting_probability: 1.0e-4}\n"
+      "spec: {type: reach_avoid, horizon: infinite, target: {lb: [1, 1], ub: [2, 2]}, "
+      "avoid: {lb: [-0.5, -0.5], ub: [0.5, 0.5]}}\n");
+  const Policy reference = run(a, DeviceKind::Reference, SweepChoice::Auto, nullptr);
+  EXPECT_LE(reference.gap, kTolerance);
+  for (SweepChoice sweep : {SweepChoice::Dense, SweepChoice::Factored}) {
+    const Policy opencl = run(a, DeviceKind::Cpu, sweep, nullptr);
+    double lower = 0, upper = 0;
+    for (std::size_t x = 0; x < a.states.size(); ++x) {
+      lower = std::max(lower, std::fabs(opencl.value(0, x) - reference.value(0, x)));
+      upper = std::max(upper, std::fabs(opencl.upper_values[x] - reference.upper_values[x]));
+    }
+    EXPECT_LE(lower, kOpenClTolerance);
+    EXPECT_LE(upper, kOpenClTolerance);
+    EXPECT_LE(opencl.gap, kTolerance);
+    std::printf("robot %s: %u iterations, max |lower - reference| %.3g, max |upper - reference| %.3g, V_0 at "
+                "(-2, -2) %.6f\n",
+                to_string(sweep).c_str(), opencl.iterations, lower, upper, opencl.value(0, 0));
+  }
+}
+
 TEST(Unbounded, ConfigurationKeys) {
   const Config config = config_from_yaml(YAML::Load(kRuin));
   EXPECT_TRUE(config.spec.unbounded);
