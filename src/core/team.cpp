@@ -110,6 +110,7 @@ Team::Team(std::vector<TeamDevice> devices, Communicator& communicator)
   double weight = 0;
   for (const TeamDevice& device : devices_) weight += device.weight;
   rank_weights_ = communicator_.allgather_value(weight);
+  for (double count : communicator_.allgather_value(double(devices_.size()))) total_devices_ += std::size_t(count);
 }
 
 Split Team::split(std::uint64_t total) const {

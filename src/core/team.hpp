@@ -38,6 +38,8 @@ class Team {
   Team(std::vector<TeamDevice> devices, Communicator& communicator);
   std::vector<TeamDevice>& devices() { return devices_; }
   Communicator& communicator() { return communicator_; }
+  /// Devices of every rank together.
+  std::size_t total_devices() const { return total_devices_; }
   /// [0, total) split over the ranks by their weights, and this rank's range over its devices.
   Split split(std::uint64_t total) const;
   /// Every device wrote its range of its buffer (elements of `element_bytes`, split in
@@ -53,6 +55,7 @@ class Team {
   std::vector<TeamDevice> devices_;
   Communicator& communicator_;
   std::vector<double> rank_weights_;
+  std::size_t total_devices_ = 0;
   double exchange_seconds_ = 0;
 };
 
@@ -74,16 +77,22 @@ Policy run_dense_team(const Abstraction& abstraction, Team& team, const Synthesi
 std::vector<std::string> describe_dense_team(const Abstraction& abstraction, Team& team, const SynthesisOptions& options,
                                              const OpenClEngineOptions& engine_options);
 
-/// A stage's output entries in `parts` contiguous parts of `entries` each: one per value of the
-/// output digits before its vector digit, so that a part is also a contiguous range of
-/// work-items whatever the device's stage shape. parts 1: not split (every device computes it).
+/// How a stage's output entries are split: in `parts` contiguous parts of `entries` each. By the
+/// major output digit when it has at least as many values as there are devices (then a stage
+/// split by the same variable digit next reads only the part its device computed, and no
+/// exchange is needed between them); else by every digit before the vector digit (a part is then
+/// still a contiguous range of work-items whatever the device's stage shape); parts 1: not split,
+/// every device computes the whole stage (its vector digit is the major one).
 struct StageParts {
   std::uint64_t parts = 1, entries = 0;
+  bool by_major_digit = false;
 };
-StageParts stage_parts(const FactoredStage& stage);
+StageParts stage_parts(const FactoredStage& stage, std::size_t devices);
+/// Whether the output of stage `k` must be exchanged before stage k + 1 runs.
+bool exchange_after(const FactoredPlan& plan, const std::vector<StageParts>& parts, std::size_t k);
 
 /// The factored sweep over the team: every stage's output entries (and the input choice's
-/// states) split in contiguous ranges, each device's part exchanged after each stage.
+/// states) split in contiguous ranges, each device's part exchanged where the next stage needs it.
 Policy run_factored_team(const Abstraction& abstraction, const FactoredPlan& plan, Team& team,
                          const OpenClEngineOptions& engine_options, bool profile, SynthesisReport& report,
                          const TeamProgress& progress);

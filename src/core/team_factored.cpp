@@ -34,22 +34,27 @@ void launch_range(cl_command_queue queue, cl_kernel kernel, std::uint64_t first,
   }
 }
 
-// A stage's split: parts over the team, and their entries.
+// A stage's split: parts over the team, their entries, and whether the next stage needs the
+// whole output (then it is exchanged).
 struct StageSplit {
   StageParts parts;
   Split by_part, by_entry;
+  bool exchange = false;
 };
 
 std::vector<StageSplit> stage_splits(const FactoredPlan& plan, const Team& team) {
   std::vector<StageSplit> splits;
   for (const FactoredStage& stage : plan.stages) {
     StageSplit split;
-    split.parts = stage_parts(stage);
+    split.parts = stage_parts(stage, team.total_devices());
     split.by_part = team.split(split.parts.parts);
     const std::uint64_t entries = split.parts.entries;
     split.by_entry = split.by_part.mapped([entries](std::uint64_t part) { return part * entries; });
     splits.push_back(split);
   }
+  std::vector<StageParts> parts;
+  for (const StageSplit& split : splits) parts.push_back(split.parts);
+  for (std::size_t k = 0; k < splits.size(); ++k) splits[k].exchange = exchange_after(plan, parts, k);
   return splits;
 }
 
@@ -57,7 +62,7 @@ std::vector<StageSplit> stage_splits(const FactoredPlan& plan, const Team& team)
 double exchange_bytes_per_step(const Abstraction& a, const FactoredPlan& plan, const std::vector<StageSplit>& splits) {
   double bytes = 12.0 * double(a.states.size());
   for (std::size_t k = 0; k < plan.stages.size(); ++k) {
-    if (splits[k].parts.parts == 1) continue;
+    if (!splits[k].exchange) continue;
     const bool last = k + 1 == plan.stages.size();
     bytes += 8.0 * double(plan.stages[k].output_size) * (last ? 1.0 : double(plan.slices));
   }
@@ -70,12 +75,32 @@ void finish_all(Team& team) {
 
 }  // namespace
 
-StageParts stage_parts(const FactoredStage& stage) {
+StageParts stage_parts(const FactoredStage& stage, std::size_t devices) {
   StageParts parts;
-  const std::size_t prefix = stage.vector_digit ? *stage.vector_digit : stage.output.size();
-  for (std::size_t j = 0; j < prefix; ++j) parts.parts *= stage.output[j].radix;
+  if (stage.vector_digit && *stage.vector_digit == 0) {
+    parts.entries = stage.output_size;
+    return parts;
+  }
+  if (stage.output.front().radix >= devices) {
+    parts.parts = stage.output.front().radix;
+    parts.by_major_digit = true;
+  } else {
+    const std::size_t prefix = stage.vector_digit ? *stage.vector_digit : stage.output.size();
+    for (std::size_t j = 0; j < prefix; ++j) parts.parts *= stage.output[j].radix;
+  }
   parts.entries = stage.output_size / parts.parts;
   return parts;
+}
+
+bool exchange_after(const FactoredPlan& plan, const std::vector<StageParts>& parts, std::size_t k) {
+  if (parts[k].parts == 1) return false;  // every device computed all of it
+  if (k + 1 == plan.stages.size()) return true;
+  // Stage k + 1 split by the same variable digit reads only entries of its device's part.
+  const TensorDigit& mine = plan.stages[k].output.front();
+  const TensorDigit& next = plan.stages[k + 1].output.front();
+  const bool chained = parts[k].by_major_digit && parts[k + 1].by_major_digit && !mine.post && !next.post &&
+                       mine.id == next.id && mine.radix == next.radix;
+  return !chained;
 }
 
 Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& team,
@@ -149,11 +174,11 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
           check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
         }
         finish_all(team);
-        if (!last && split.parts.parts > 1)
+        if (!last && split.exchange)
           team.exchange(split.by_entry, sizeof(double), exchanged, host_tensor.data(), true);
       }
     }
-    if (splits[last_stage].parts.parts > 1)
+    if (splits[last_stage].exchange)
       team.exchange(splits[last_stage].by_entry, sizeof(double), exchanged, host_q.data(), true);
     std::vector<cl_mem> inputs(devices.size());
     for (std::size_t i = 0; i < devices.size(); ++i) {
@@ -193,7 +218,7 @@ std::vector<std::string> describe_factored_team(const Abstraction& a, const Fact
   const std::vector<StageSplit> splits = stage_splits(plan, team);
   std::vector<std::string> lines = {
       "factored sweep: every stage's output entries split in contiguous ranges by device throughput, "
-      "exchanged after each stage (Q once per step)"};
+      "exchanged where the next stage needs the whole tensor (Q once per step)"};
   for (std::size_t k = 0; k < plan.stages.size(); ++k) {
     const StageSplit& split = splits[k];
     std::string line = "stage " + std::to_string(k) + " (x'" + std::to_string(plan.stages[k].dimension) + "): " +
@@ -202,9 +227,16 @@ std::vector<std::string> describe_factored_team(const Abstraction& a, const Fact
     if (split.parts.parts == 1) {
       line += ", not split (every device computes all: its vector digit is the major one)";
     } else {
+      line += std::string(", split by ") + (split.parts.by_major_digit ? "its major digit" : "entries") + " into " +
+              std::to_string(split.parts.parts) + " parts";
       for (std::size_t r = 0; r < split.by_entry.ranks.size(); ++r)
         line += ", rank " + std::to_string(r) + " [" + std::to_string(split.by_entry.ranks[r].begin) + ", " +
                 std::to_string(split.by_entry.ranks[r].end) + ")";
+      for (std::size_t i = 0; i < split.by_entry.devices.size(); ++i)
+        line += ", rank " + std::to_string(split.by_entry.rank) + " device " + std::to_string(i) + " [" +
+                std::to_string(split.by_entry.devices[i].begin) + ", " + std::to_string(split.by_entry.devices[i].end) +
+                ")";
+      line += split.exchange ? "; exchanged" : "; not exchanged (the next stage reads only its device's part)";
     }
     lines.push_back(line);
   }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,45 @@ TEST(Split, ContiguousCoveringAndProportionalToWeight) {
   const auto few = detail::split_by_weight(2, {1, 1, 1});
   EXPECT_EQ(few.back().end, 2u);
   for (std::size_t i = 1; i < few.size(); ++i) EXPECT_EQ(few[i].begin, few[i - 1].end);
+}
+
+// A stage whose output digits have the given radices (variables, ids 0, 1, ...).
+detail::FactoredStage stage_with(const std::vector<std::size_t>& radices, std::optional<std::size_t> vector_digit) {
+  detail::FactoredStage stage;
+  stage.output_size = 1;
+  for (std::size_t j = 0; j < radices.size(); ++j) {
+    stage.output.push_back({false, j, radices[j]});
+    stage.output_size *= radices[j];
+  }
+  stage.vector_digit = vector_digit;
+  return stage;
+}
+
+TEST(StageParts, MajorDigitWhenItHasEnoughValuesElseEveryDigitBeforeTheVectorDigit) {
+  const auto by_major = detail::stage_parts(stage_with({8, 3, 5}, 2), 2);
+  EXPECT_TRUE(by_major.by_major_digit);
+  EXPECT_EQ(by_major.parts, 8u);
+  EXPECT_EQ(by_major.entries, 15u);
+  const auto by_prefix = detail::stage_parts(stage_with({2, 3, 5}, 2), 4);
+  EXPECT_FALSE(by_prefix.by_major_digit);
+  EXPECT_EQ(by_prefix.parts, 6u);
+  EXPECT_EQ(by_prefix.entries, 5u);
+  const auto scalar = detail::stage_parts(stage_with({2, 3}, std::nullopt), 4);
+  EXPECT_EQ(scalar.parts, 6u);
+  EXPECT_EQ(scalar.entries, 1u);
+  const auto whole = detail::stage_parts(stage_with({4, 3}, 0), 2);
+  EXPECT_EQ(whole.parts, 1u);
+}
+
+TEST(StageParts, NoExchangeBetweenStagesSplitByTheSameVariable) {
+  detail::FactoredPlan plan;
+  plan.stages = {stage_with({8, 3}, 1), stage_with({8, 5}, 1), stage_with({6, 5}, 1)};
+  plan.stages[2].output[0].id = 7;  // another variable
+  std::vector<detail::StageParts> parts;
+  for (const auto& stage : plan.stages) parts.push_back(detail::stage_parts(stage, 2));
+  EXPECT_FALSE(detail::exchange_after(plan, parts, 0));  // same variable 0, 8 values
+  EXPECT_TRUE(detail::exchange_after(plan, parts, 1));   // the next is split by variable 7
+  EXPECT_TRUE(detail::exchange_after(plan, parts, 2));   // Q: the input choice reads all of it
 }
 
 TEST(DeviceSelector, ParsesKindsIndicesAndParts) {
