@@ -42,6 +42,13 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
     text += "dynamics:\n";
     for (const auto& expression : config.dynamics) text += "  - " + quoted(expression) + "\n";
   }
+  // The default integrator is left out, so configurations without the key keep their text and hash.
+  if (!config.integrator.is_default()) {
+    text += "integrator: {method: " + to_string(config.integrator.method) +
+            ", substeps: " + std::to_string(config.integrator.substeps);
+    if (config.integrator.tau) text += ", tau: " + format_number(*config.integrator.tau);
+    text += "}\n";
+  }
   const NoiseConfig& noise = config.noise;
   text += "noise:\n";
   text += "  type: " + to_string(noise.type) + "\n";

@@ -46,6 +46,12 @@ const std::vector<std::pair<const char*, Truncation>>& enum_names() {
   return names;
 }
 template <>
+const std::vector<std::pair<const char*, IntegrationMethod>>& enum_names() {
+  static const std::vector<std::pair<const char*, IntegrationMethod>> names = {{"euler", IntegrationMethod::Euler},
+                                                                               {"rk4", IntegrationMethod::Rk4}};
+  return names;
+}
+template <>
 const std::vector<std::pair<const char*, Phase>>& enum_names() {
   static const std::vector<std::pair<const char*, Phase>> names = {
       {"setup", Phase::Setup}, {"construction", Phase::Construction}, {"synthesis", Phase::Synthesis}, {"done", Phase::Done}};
@@ -83,6 +89,7 @@ std::string to_string(SweepChoice value) { return name_of(value); }
 std::string to_string(NoiseType value) { return name_of(value); }
 std::string to_string(Distribution value) { return name_of(value); }
 std::string to_string(Truncation value) { return name_of(value); }
+std::string to_string(IntegrationMethod value) { return name_of(value); }
 std::string to_string(Phase value) { return name_of(value); }
 std::string to_string(NoteSeverity value) { return name_of(value); }
 std::string to_string(NoteKind value) { return name_of(value); }

@@ -68,8 +68,8 @@ OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<st
         size *= double(counts[r]);
         ++posts_left;
       }
-    // Vector digits: V's last dimension in the first stage, a remaining post cell in the middle
-    // stages, a variable the contracted coordinate does not read in the last one.
+    // Vector digits (see vector_digits): V's last dimension in the first stage; later, a remaining
+    // post cell or a variable the contracted coordinate does not read.
     bool vector = false;
     if (k == 0) {
       vector = dims >= 2 && dim != dims - 1;
@@ -131,7 +131,8 @@ std::uint64_t stride_in(const std::vector<TensorDigit>& layout, const std::vecto
 // stage's input and output, read by no mass of the contracted coordinate (so that the entries
 // share their masses and window) and be the input's fastest digit (contiguous values). The first
 // stage reads V, whose fastest digit is the last post dimension; later inputs are laid out by the
-// stage before, which puts the next stage's vector digit last. nullopt: the stage runs scalar.
+// stage before, which puts the next stage's vector digit last, so any remaining post cell or
+// unread variable qualifies: the one with the most values. nullopt: the stage runs scalar.
 struct DigitId {
   bool post;
   std::size_t id;
@@ -156,7 +157,7 @@ std::vector<std::optional<DigitId>> vector_digits(const std::vector<std::size_t>
           best_radix = radix_of_post(r);
           digits[k] = DigitId{true, r};
         }
-      for (std::size_t v = 0; v < variables.size() && !digits[k]; ++v)
+      for (std::size_t v = 0; v < variables.size(); ++v)
         if (used[v] && std::find(reads[dim].begin(), reads[dim].end(), v) == reads[dim].end() &&
             variables[v].count > best_radix) {
           best_radix = variables[v].count;
@@ -197,6 +198,12 @@ std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
     for (std::size_t v : reads[dim])
       if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
         stage.output.push_back({false, v, variables[v].count});
+    // Q: input and disturbance digits last, so that the input choice reads each state's values
+    // from one stretch of memory.
+    if (k + 1 == order.size())
+      std::stable_partition(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
+        return variables[digit.id].space == FactorVariable::Space::State;
+      });
     // The next stage's contracted cell goes just before its vector digit: each work-item's
     // window is then one contiguous block of the next input.
     if (k + 1 < order.size()) {

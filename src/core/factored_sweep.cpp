@@ -10,6 +10,7 @@
 #include "factored_program.hpp"
 #include "factored_tables.hpp"
 #include "opencl_program_cache.hpp"
+#include "opencl_run.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -48,19 +49,15 @@ FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan&
                                        cl_context context, const std::string& cache_dir, bool entry_per_item,
                                        std::vector<EngineNote>& notes) {
   FactoredKernels kernels;
-  cl_int error = CL_SUCCESS;
   kernels.shape = stage_shape_for(entry_per_item ? 1 : device.native_double_width);
   notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
                    std::string("factored stages: ") +
                        (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
                                                    : "one entry per work-item, neighbours contiguous (SIMT device)")});
   kernels.program = build_program(context, device, factored_program_source(a, plan, kernels.shape), cache_dir, notes);
-  for (std::size_t k = 0; k < plan.stages.size(); ++k) {
-    kernels.stages.emplace_back(clCreateKernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str(), &error));
-    check(error, "clCreateKernel(stage)");
-  }
-  kernels.choose = Kernel(clCreateKernel(kernels.program.get(), "choose_inputs", &error));
-  check(error, "clCreateKernel(choose_inputs)");
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    kernels.stages.push_back(create_kernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str()));
+  kernels.choose = create_kernel(kernels.program.get(), "choose_inputs");
   return kernels;
 }
 
@@ -163,15 +160,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   };
 
   // --- synthesis, V_{T_d} -> V_0
-  Policy policy;
-  policy.states = a.states;
-  policy.inputs = a.inputs;
-  policy.horizon = a.horizon;
-  policy.roles = a.roles;
-  policy.computed_by = run.device->label();
-  policy.config_hash = config_hash(a.config);
-  policy.values.assign((std::size_t(a.horizon) + 1) * n_states, 0.0);
-  policy.input_index.assign(std::size_t(a.horizon) * n_states, 0);
+  Policy policy = empty_policy(a, run.device->label());
   std::copy(terminal.begin(), terminal.begin() + std::ptrdiff_t(n_states),
             policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
 

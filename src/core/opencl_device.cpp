@@ -168,6 +168,13 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
   }
 }
 
+Kernel create_kernel(cl_program program, const char* name) {
+  cl_int error = CL_SUCCESS;
+  Kernel kernel(clCreateKernel(program, name, &error));
+  check(error, (std::string("clCreateKernel(") + name + ")").c_str());
+  return kernel;
+}
+
 std::string selected_device_label(const ComputeConfig& compute) {
   std::vector<EngineNote> ignored_notes;
   try {

@@ -43,6 +43,9 @@ using Program = ClHandle<cl_program, clReleaseProgram>;
 using Kernel = ClHandle<cl_kernel, clReleaseKernel>;
 using Buffer = ClHandle<cl_mem, clReleaseMemObject>;
 
+/// The kernel `name` of a built program; DeviceError naming it when it is missing.
+Kernel create_kernel(cl_program program, const char* name);
+
 /// A string property of a platform or a device; "?" when the query fails.
 std::string platform_string(cl_platform_id platform, cl_platform_info what);
 std::string device_string(cl_device_id device, cl_device_info what);

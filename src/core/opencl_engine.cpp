@@ -80,27 +80,6 @@ std::optional<FactoredPlan> choose_factored(const Abstraction& a, const DeviceIn
   return plan;
 }
 
-Kernel create_kernel(cl_program program, const char* name) {
-  cl_int error = CL_SUCCESS;
-  Kernel kernel(clCreateKernel(program, name, &error));
-  check(error, (std::string("clCreateKernel(") + name + ")").c_str());
-  return kernel;
-}
-
-// The policy before the sweep: grids, roles, provenance, V_{T_d} and room for every step.
-Policy empty_policy(const Abstraction& a, const std::string& device_label) {
-  Policy policy;
-  policy.states = a.states;
-  policy.inputs = a.inputs;
-  policy.horizon = a.horizon;
-  policy.roles = a.roles;
-  policy.computed_by = device_label;
-  policy.config_hash = config_hash(a.config);
-  policy.values.assign((std::size_t(a.horizon) + 1) * a.states.size(), 0.0);
-  policy.input_index.assign(std::size_t(a.horizon) * a.states.size(), 0);
-  return policy;
-}
-
 // Step `step` of the policy's values from a padded value array.
 void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded_index, const double* padded) {
   double* out = policy.values.data() + std::size_t(step) * padded_index.size();

@@ -52,12 +52,8 @@ void check_dense_supported(const Layout& layout);
 /// Sweep note says which and why.
 std::optional<FactoredPlan> choose_factored(const Abstraction& abstraction, const DeviceInfo& device,
                                             const SynthesisOptions& options, SynthesisReport& report);
-/// The policy before the sweep: grids, roles, provenance, room for every step, V_{T_d} not set.
-Policy empty_policy(const Abstraction& abstraction, const std::string& device_label);
 /// Step `step` of the policy's values from a padded value array.
 void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded_index, const double* padded);
-/// The program's kernel `name` (DeviceError when missing).
-Kernel create_kernel(cl_program program, const char* name);
 
 /// Label ("platform / device") of the device that `compute` selects, or "" when none matches.
 std::string selected_device_label(const ComputeConfig& compute);

@@ -29,6 +29,19 @@ void set_argument(cl_kernel kernel, cl_uint index, std::size_t size, const void*
 
 }  // namespace
 
+Policy empty_policy(const Abstraction& a, const std::string& device_label) {
+  Policy policy;
+  policy.states = a.states;
+  policy.inputs = a.inputs;
+  policy.horizon = a.horizon;
+  policy.roles = a.roles;
+  policy.computed_by = device_label;
+  policy.config_hash = config_hash(a.config);
+  policy.values.assign((std::size_t(a.horizon) + 1) * a.states.size(), 0.0);
+  policy.input_index.assign(std::size_t(a.horizon) * a.states.size(), 0);
+  return policy;
+}
+
 DeviceSession open_session(const DeviceInfo& device) {
   cl_int error = CL_SUCCESS;
   const cl_context_properties properties[] = {CL_CONTEXT_PLATFORM,
