@@ -300,14 +300,14 @@ int run(const Options& options, cli::MpiSession& mpi) {
   std::fflush(stdout);
 
   SynthesisOptions synthesis_options;
+  synthesis_options.compute = config.compute;
   synthesis_options.communicator = mpi.communicator();
   if (options.dry_run) {
-    for (const std::string& line : describe_scale_out(abstraction, SynthesisOptions{config.compute, {}, false, mpi.communicator()}))
+    for (const std::string& line : describe_scale_out(abstraction, synthesis_options))
       std::printf("plan: %s\n", line.c_str());
     std::printf("dry run: nothing computed, no file written\n");
     return 0;
   }
-  synthesis_options.compute = config.compute;
   synthesis_options.profile = options.profile;
   const bool quiet = options.quiet;
   synthesis_options.progress = [quiet](const Progress& progress) {

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #ifdef AMYTISS_WITH_MPI
@@ -25,7 +25,8 @@ bool started_by_launcher() {
 }
 
 void check_mpi(int code, const char* call) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string(call) + " failed (MPI error " + std::to_string(code) + ")");
+  if (code != MPI_SUCCESS)
+    throw std::runtime_error(std::string(call) + " failed (MPI error " + std::to_string(code) + ")");
 }
 
 class MpiCommunicator : public Communicator {

@@ -16,6 +16,11 @@ namespace amytiss::detail {
 /// row may read that far past it.
 constexpr std::size_t kTensorSlack = 8;
 
+/// Launches of the factored sweep: at most this many work-items each (watchdogs, and 32-bit
+/// work-item limits of some drivers), in groups of kFactoredGroupSize (or the device's maximum).
+constexpr std::size_t kFactoredMaxLaunchItems = std::size_t(1) << 30;
+constexpr std::size_t kFactoredGroupSize = 64;
+
 /// How a stage with a vector digit maps to work-items. SIMD devices (CPUs: native double vector
 /// width > 1) take a row of the vector digit per work-item in explicit vectors; SIMT devices
 /// (GPUs: width 1) one entry per work-item with the vector digit fastest, so that neighbouring
@@ -54,11 +59,20 @@ struct DeviceTable {
 struct MassTable;
 /// Multiply-adds stage `stage` does over all slices of one time step.
 double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, std::size_t slices);
+/// Where stage k of slice `slice` reads and writes: the input's offset (first stage of a slice
+/// reads the slice out of V), the block [lo, hi) of the contracted dimension that the input holds
+/// (the last stage contracts the slice's cells only), and whether to add to the output (later
+/// slices of the last stage accumulate into Q, in slice order).
+struct StagePlacement {
+  cl_ulong in_offset = 0;
+  cl_uint lo = 0, hi = 0, accumulate = 0;
+};
+StagePlacement stage_placement(const Abstraction& abstraction, const FactoredPlan& plan, std::size_t k,
+                               std::size_t slice);
 /// Arguments of a stage kernel: input and output tensors, the contracted dimension's table, the
-/// input's offset (first stage of a slice), the block [lo, hi) of the contracted dimension that
-/// the input holds, and whether to add to the output (later slices of the last stage).
-void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table, cl_ulong in_offset,
-                         cl_uint lo, cl_uint hi, cl_uint accumulate);
+/// placement.
+void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
+                         const StagePlacement& placement);
 
 /// A device's program of the plan (stage kernels, choose_inputs) in the shape the device wants
 /// (entry_per_item: the SIMT shape whatever the device); a note says which shape.

@@ -18,11 +18,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-// Launches are split so that no single launch covers more entries than this (watchdogs, and
-// 32-bit work-item limits of some drivers).
-constexpr std::size_t kMaxLaunchEntries = std::size_t(1) << 30;
-constexpr std::size_t kGroupSize = 64;
-
 }  // namespace
 
 // Every tuple of the contracted dimension's table occurs output_size / tuples times per slice,
@@ -32,17 +27,31 @@ double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, s
   return double(stage.output_size) * double(slices) / double(table.count.size()) * kept;
 }
 
-void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table, cl_ulong in_offset,
-                         cl_uint lo, cl_uint hi, cl_uint accumulate) {
+StagePlacement stage_placement(const Abstraction& a, const FactoredPlan& plan, std::size_t k, std::size_t slice) {
+  // V's stride of the sliced dimension (row-major over the state grid).
+  std::uint64_t sliced_stride = 1;
+  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
+  const bool last = k + 1 == plan.stages.size();
+  const cl_uint block_first = cl_uint(slice * plan.slice_cells);
+  StagePlacement placement;
+  placement.in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
+  placement.lo = last ? block_first : 0;
+  placement.hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(plan.stages[k].dimension));
+  placement.accumulate = last && slice > 0;
+  return placement;
+}
+
+void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
+                         const StagePlacement& placement) {
   check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &in), "clSetKernelArg");
   check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &out), "clSetKernelArg");
   check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &table.first.handle), "clSetKernelArg");
   check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &table.count.handle), "clSetKernelArg");
   check(clSetKernelArg(kernel, 4, sizeof(cl_mem), &table.masses.handle), "clSetKernelArg");
-  check(clSetKernelArg(kernel, 5, sizeof(cl_ulong), &in_offset), "clSetKernelArg");
-  check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &lo), "clSetKernelArg");
-  check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &hi), "clSetKernelArg");
-  check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &accumulate), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 5, sizeof(cl_ulong), &placement.in_offset), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &placement.lo), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &placement.hi), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
 }
 
 FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,
@@ -144,11 +153,11 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   }
   stage_bytes.back() = 8.0 * double(plan.q_size) + 12.0 * double(n_states);
   bytes_per_step += stage_bytes.back();
-  const std::size_t group = std::min(kGroupSize, std::max<std::size_t>(1, run.device->max_work_group));
+  const std::size_t group = std::min(kFactoredGroupSize, std::max<std::size_t>(1, run.device->max_work_group));
   auto launch = [&](cl_kernel kernel, std::size_t entries, std::size_t timing_slot) {
     const auto launch_start = Clock::now();
-    for (std::size_t offset = 0; offset < entries; offset += kMaxLaunchEntries) {
-      const std::size_t count = std::min(kMaxLaunchEntries, entries - offset);
+    for (std::size_t offset = 0; offset < entries; offset += kFactoredMaxLaunchItems) {
+      const std::size_t count = std::min(kFactoredMaxLaunchItems, entries - offset);
       const std::size_t global = (count + group - 1) / group * group;
       check(clEnqueueNDRangeKernel(run.queue, kernel, 1, &offset, &global, &group, 0, nullptr, nullptr),
             "clEnqueueNDRangeKernel(factored sweep)");
@@ -165,15 +174,11 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
             policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
 
   const std::size_t last_stage = plan.stages.size() - 1;
-  // V's stride of the sliced dimension (row-major over the state grid).
-  std::uint64_t sliced_stride = 1;
-  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
   const auto synthesis_start = Clock::now();
   int current = 0;
   for (unsigned step = a.horizon; step-- > 0;) {
     phase_start = Clock::now();
     for (std::size_t slice = 0; slice < plan.slices; ++slice) {
-      const cl_uint block_first = cl_uint(slice * plan.slice_cells);
       for (std::size_t k = 0; k < plan.stages.size(); ++k) {
         const FactoredStage& stage = plan.stages[k];
         const DeviceTable& table = device_tables[stage.dimension];
@@ -181,12 +186,8 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
         cl_mem in = k == 0 ? values[current].get() : stage_tensors[(k - 1) % 2].get();
         cl_mem out = last ? q.get() : stage_tensors[k % 2].get();
         // The first stage reads the slice out of V; the last contracts the slice's cells only.
-        const cl_ulong in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
-        const cl_uint lo = last ? block_first : 0;
-        const cl_uint hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(stage.dimension));
-        const cl_uint accumulate = last && slice > 0;
         cl_kernel kernel = stage_kernels[k].get();
-        set_stage_arguments(kernel, in, out, table, in_offset, lo, hi, accumulate);
+        set_stage_arguments(kernel, in, out, table, stage_placement(a, plan, k, slice));
         launch(kernel, stage_work_items(stage, shape), k);
       }
     }

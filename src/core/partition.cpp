@@ -22,7 +22,9 @@ std::vector<Range> split_by_weight(std::uint64_t total, const std::vector<double
     assert(weights[i] > 0);
     cumulative += weights[i];
     const std::uint64_t end =
-        i + 1 == weights.size() ? total : std::min<std::uint64_t>(total, std::uint64_t(std::llround(double(total) * cumulative / sum)));
+        i + 1 == weights.size()
+            ? total
+            : std::min<std::uint64_t>(total, std::uint64_t(std::llround(double(total) * cumulative / sum)));
     ranges[i] = {begin, std::max(begin, end)};
     begin = ranges[i].end;
   }
@@ -55,9 +57,12 @@ std::optional<DeviceSelector> parse_device_selector(const std::string& text) {
   }
   if (const auto colon = head.find(':'); colon != std::string::npos) {
     const std::string kind = head.substr(0, colon);
-    if (kind == "gpu") selector.kind = DeviceSelector::Kind::Gpu;
-    else if (kind == "cpu") selector.kind = DeviceSelector::Kind::Cpu;
-    else return std::nullopt;
+    if (kind == "gpu")
+      selector.kind = DeviceSelector::Kind::Gpu;
+    else if (kind == "cpu")
+      selector.kind = DeviceSelector::Kind::Cpu;
+    else
+      return std::nullopt;
     if (!read_index(head.substr(colon + 1), selector.index)) return std::nullopt;
     return selector;
   }

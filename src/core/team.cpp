@@ -19,8 +19,11 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 std::vector<DeviceInfo> with_double_precision(std::vector<EngineNote>& notes) {
   std::vector<DeviceInfo> usable;
   for (const DeviceInfo& info : enumerate_devices()) {
-    if (info.fp64) usable.push_back(info);
-    else notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "skipping " + info.label() + ": no double precision"});
+    if (info.fp64)
+      usable.push_back(info);
+    else
+      notes.push_back(
+          {NoteSeverity::Info, NoteKind::DeviceChoice, "skipping " + info.label() + ": no double precision"});
   }
   return usable;
 }
@@ -45,7 +48,8 @@ DeviceInfo select(const std::vector<DeviceInfo>& usable, const DeviceSelector& s
 
 // The device split into equal sub-devices of `units` compute units each.
 std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, const std::string& text) {
-  const cl_device_partition_property properties[] = {CL_DEVICE_PARTITION_EQUALLY, cl_device_partition_property(units), 0};
+  const cl_device_partition_property properties[] = {CL_DEVICE_PARTITION_EQUALLY, cl_device_partition_property(units),
+                                                     0};
   cl_uint count = 0;
   cl_int error = clCreateSubDevices(parent.device, properties, 0, nullptr, &count);
   if (error != CL_SUCCESS || count == 0)
@@ -96,10 +100,11 @@ std::vector<TeamDevice> open_team_devices(const ComputeConfig& compute, std::vec
     }
   }
   for (TeamDevice& member : team) {
-    const DevicePeak peak = double_fma_peak(member.info.is_gpu(), member.info.is_cpu(), member.info.label(),
-                                            member.info.compute_units, member.info.max_clock_mhz,
-                                            member.info.native_double_width);
-    member.weight = peak.multiply_adds_per_second > 0 ? peak.multiply_adds_per_second : double(member.info.compute_units);
+    const DevicePeak peak =
+        double_fma_peak(member.info.is_gpu(), member.info.is_cpu(), member.info.label(), member.info.compute_units,
+                        member.info.max_clock_mhz, member.info.native_double_width);
+    member.weight =
+        peak.multiply_adds_per_second > 0 ? peak.multiply_adds_per_second : double(member.info.compute_units);
     member.session = open_session(member.info);
   }
   return team;
@@ -152,9 +157,9 @@ void Team::exchange(const Split& split, std::size_t element_bytes, const std::ve
       const Range others[] = {{0, own.begin}, {own.end, total}};
       for (const Range& range : others) {
         if (range.empty()) continue;
-        check(clEnqueueWriteBuffer(devices_[i].session.queue.get(), buffers[i], CL_FALSE,
-                                   range.begin * element_bytes, range.size() * element_bytes,
-                                   bytes + range.begin * element_bytes, 0, nullptr, nullptr),
+        check(clEnqueueWriteBuffer(devices_[i].session.queue.get(), buffers[i], CL_FALSE, range.begin * element_bytes,
+                                   range.size() * element_bytes, bytes + range.begin * element_bytes, 0, nullptr,
+                                   nullptr),
               "clEnqueueWriteBuffer(exchange)");
       }
     }

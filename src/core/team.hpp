@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "amytiss/engine.hpp"
-#include "opencl_engine.hpp"
 #include "opencl_device.hpp"
+#include "opencl_engine.hpp"
 #include "opencl_run.hpp"
 #include "partition.hpp"
 
@@ -74,7 +74,8 @@ using TeamProgress = std::function<void(Phase, unsigned, double)>;
 Policy run_dense_team(const Abstraction& abstraction, Team& team, const SynthesisOptions& options,
                       const OpenClEngineOptions& engine_options, SynthesisReport& report, const TeamProgress& progress);
 /// The dense sweep's split, memory per device and exchange per step, without computing.
-std::vector<std::string> describe_dense_team(const Abstraction& abstraction, Team& team, const SynthesisOptions& options,
+std::vector<std::string> describe_dense_team(const Abstraction& abstraction, Team& team,
+                                             const SynthesisOptions& options,
                                              const OpenClEngineOptions& engine_options);
 
 /// How a stage's output entries are split: in `parts` contiguous parts of `entries` each. By the
@@ -94,7 +95,7 @@ bool exchange_after(const FactoredPlan& plan, const std::vector<StageParts>& par
 /// The factored sweep over the team: every stage's output entries (and the input choice's
 /// states) split in contiguous ranges, each device's part exchanged where the next stage needs it.
 Policy run_factored_team(const Abstraction& abstraction, const FactoredPlan& plan, Team& team,
-                         const OpenClEngineOptions& engine_options, bool profile, SynthesisReport& report,
+                         const OpenClEngineOptions& engine_options, SynthesisReport& report,
                          const TeamProgress& progress);
 /// The factored sweep's split and exchange per step, without computing.
 std::vector<std::string> describe_factored_team(const Abstraction& abstraction, const FactoredPlan& plan, Team& team);

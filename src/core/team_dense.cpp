@@ -45,7 +45,8 @@ Policy run_dense_team(const Abstraction& a, Team& team, const SynthesisOptions& 
   const std::size_t n_states = a.states.size();
   const Split states = team.split(n_states);
   std::vector<TeamDevice>& devices = team.devices();
-  for (const std::string& line : team.describe(states, "states")) rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});
+  for (const std::string& line : team.describe(states, "states"))
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});
 
   auto phase_start = Clock::now();
   std::vector<Member> members(devices.size());
@@ -79,7 +80,8 @@ Policy run_dense_team(const Abstraction& a, Team& team, const SynthesisOptions& 
                             members[i].buffers, false);
   for (TeamDevice& device : devices) check(clFinish(device.session.queue.get()), "clFinish(construct)");
   const double construction_seconds = seconds_since(phase_start);
-  rep.phases.push_back({"construction", construction_seconds, double(a.pairs()) / std::max(construction_seconds, 1e-9), 0});
+  rep.phases.push_back(
+      {"construction", construction_seconds, double(a.pairs()) / std::max(construction_seconds, 1e-9), 0});
   if (progress) progress(Phase::Construction, 0, -1);
 
   std::string label;
@@ -97,15 +99,16 @@ Policy run_dense_team(const Abstraction& a, Team& team, const SynthesisOptions& 
     phase_start = Clock::now();
     for (std::size_t i = 0; i < devices.size(); ++i) {
       Member& m = members[i];
-      if (!m.buffers.chunks.empty()) enqueue_sweep(devices[i].session.queue.get(), m.sweep.get(), m.plan, m.buffers, current);
+      if (!m.buffers.chunks.empty())
+        enqueue_sweep(devices[i].session.queue.get(), m.sweep.get(), m.plan, m.buffers, current);
       check(clFlush(devices[i].session.queue.get()), "clFlush(synthesize)");
       value_buffers[i] = m.buffers.values[1 - current].get();
       input_buffers[i] = m.buffers.best_input.get();
     }
     for (TeamDevice& device : devices) check(clFinish(device.session.queue.get()), "clFinish(synthesize)");
     team.exchange(padded, sizeof(double), value_buffers, host_values.data(), true);
-    team.exchange(states, sizeof(std::uint32_t), input_buffers, policy.input_index.data() + std::size_t(step) * n_states,
-                  false);
+    team.exchange(states, sizeof(std::uint32_t), input_buffers,
+                  policy.input_index.data() + std::size_t(step) * n_states, false);
     current = 1 - current;
     unpad(policy, step, padded_index, host_values.data());
     const double seconds = seconds_since(phase_start);
@@ -116,7 +119,8 @@ Policy run_dense_team(const Abstraction& a, Team& team, const SynthesisOptions& 
                seconds_since(synthesis_start) / done * (a.horizon - done));
   }
   rep.exchange_seconds = team.exchange_seconds();
-  rep.phases.push_back({"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+  rep.phases.push_back(
+      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
   return policy;
 }
 
@@ -140,12 +144,13 @@ std::vector<std::string> describe_dense_team(const Abstraction& a, Team& team, c
     lines.push_back("rank " + std::to_string(states.rank) + " device " + std::to_string(i) + ": " + info.label() +
                     ", states [" + std::to_string(states.devices[i].begin) + ", " +
                     std::to_string(states.devices[i].end) + "), " + (plan.on_the_fly ? "on the fly" : "stored") +
-                    ", device memory " + format_bytes(values + records) + " (records " + format_bytes(records) + ", values " +
-                    format_bytes(values) + ") of " + format_bytes(double(info.global_memory)));
+                    ", device memory " + format_bytes(values + records) + " (records " + format_bytes(records) +
+                    ", values " + format_bytes(values) + ") of " + format_bytes(double(info.global_memory)));
   }
-  lines.push_back("exchange per step: " + format_bytes(exchange_bytes_per_step(a, layout)) +
-                  " (padded values " + format_bytes(8.0 * double(layout.padded_size)) + " + inputs " +
-                  format_bytes(4.0 * double(a.states.size())) + "), each device receiving the parts it did not compute");
+  lines.push_back("exchange per step: " + format_bytes(exchange_bytes_per_step(a, layout)) + " (padded values " +
+                  format_bytes(8.0 * double(layout.padded_size)) + " + inputs " +
+                  format_bytes(4.0 * double(a.states.size())) +
+                  "), each device receiving the parts it did not compute");
   return lines;
 }
 

@@ -55,16 +55,15 @@ Policy synthesize_team(const Abstraction& a, const SynthesisOptions& options, Sy
   rep.device = team_label(team);
   rep.phases.push_back({"device setup", std::chrono::duration<double>(Clock::now() - start).count(), 0, 0});
   const TeamProgress progress = [&](Phase phase, unsigned done, double remaining) {
-    if (options.progress &&
-        !options.progress({phase, done, a.horizon, rep.device,
-                           std::chrono::duration<double>(Clock::now() - start).count(), remaining}))
+    if (options.progress && !options.progress({phase, done, a.horizon, rep.device,
+                                               std::chrono::duration<double>(Clock::now() - start).count(), remaining}))
       throw Cancelled();
   };
   const DeviceInfo smallest = smallest_device(team);
   Policy policy;
   if (const auto factored = choose_factored(a, smallest, options, rep)) {
     rep.transitions = "factored: per-dimension mass tables on every device";
-    policy = run_factored_team(a, *factored, team, engine_options, options.profile, rep, progress);
+    policy = run_factored_team(a, *factored, team, engine_options, rep, progress);
   } else {
     check_dense_supported(Layout(a));
     policy = run_dense_team(a, team, options, engine_options, rep, progress);
@@ -79,8 +78,9 @@ Policy synthesize_team(const Abstraction& a, const SynthesisOptions& options, Sy
 std::vector<std::string> describe_scale_out(const Abstraction& a, const SynthesisOptions& options) {
   using namespace detail;
   if (options.compute.device == DeviceKind::Reference)
-    throw ConfigError("compute.device", "reference runs on the host alone; a plan of devices needs an OpenCL device "
-                                        "(example: device: auto)");
+    throw ConfigError("compute.device",
+                      "reference runs on the host alone; a plan of devices needs an OpenCL device "
+                      "(example: device: auto)");
   SynthesisReport rep;
   SoloCommunicator solo;
   Team team = open_team(options, solo, rep.notes);

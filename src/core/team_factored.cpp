@@ -19,15 +19,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-constexpr std::uint64_t kMaxLaunchItems = std::uint64_t(1) << 30;
-constexpr std::size_t kGroupSize = 64;
-
-// Work-items [first, end) of a kernel, in launches of at most kMaxLaunchItems. The last group
+// Work-items [first, end) of a kernel, in launches of at most kFactoredMaxLaunchItems. The last group
 // may run past `end`: those items compute entries of another device's range, which the exchange
 // overwrites.
 void launch_range(cl_command_queue queue, cl_kernel kernel, std::uint64_t first, std::uint64_t end, std::size_t group) {
-  for (std::uint64_t offset = first; offset < end; offset += kMaxLaunchItems) {
-    const std::size_t count = std::size_t(std::min(kMaxLaunchItems, end - offset));
+  for (std::uint64_t offset = first; offset < end; offset += kFactoredMaxLaunchItems) {
+    const std::size_t count = std::size_t(std::min<std::uint64_t>(kFactoredMaxLaunchItems, end - offset));
     const std::size_t global = (count + group - 1) / group * group, global_offset = std::size_t(offset);
     check(clEnqueueNDRangeKernel(queue, kernel, 1, &global_offset, &global, &group, 0, nullptr, nullptr),
           "clEnqueueNDRangeKernel(factored sweep)");
@@ -104,7 +101,7 @@ bool exchange_after(const FactoredPlan& plan, const std::vector<StageParts>& par
 }
 
 Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& team,
-                         const OpenClEngineOptions& engine_options, bool profile, SynthesisReport& rep,
+                         const OpenClEngineOptions& engine_options, SynthesisReport& rep,
                          const TeamProgress& progress) {
   const std::size_t n_states = a.states.size();
   std::vector<TeamDevice>& devices = team.devices();
@@ -143,39 +140,34 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
   std::vector<double> host_tensor(plan.largest_stage_tensor), host_q(plan.q_size);
   std::vector<cl_mem> exchanged(devices.size());
   const std::size_t last_stage = plan.stages.size() - 1;
-  std::uint64_t sliced_stride = 1;
-  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
   const auto synthesis_start = Clock::now();
   int current = 0;
   for (unsigned step = a.horizon; step-- > 0;) {
     phase_start = Clock::now();
     for (std::size_t slice = 0; slice < plan.slices; ++slice) {
-      const cl_uint block_first = cl_uint(slice * plan.slice_cells);
       for (std::size_t k = 0; k < plan.stages.size(); ++k) {
         const FactoredStage& stage = plan.stages[k];
         const bool last = k == last_stage;
         const StageSplit& split = splits[k];
+        const StagePlacement placement = stage_placement(a, plan, k, slice);
         for (std::size_t i = 0; i < devices.size(); ++i) {
           FactoredBuffers& b = buffers[i];
           cl_mem in = k == 0 ? b.values[current].get() : b.stage_tensors[(k - 1) % 2].get();
           cl_mem out = last ? b.q.get() : b.stage_tensors[k % 2].get();
           exchanged[i] = out;
-          const cl_ulong in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
-          const cl_uint lo = last ? block_first : 0;
-          const cl_uint hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(stage.dimension));
           cl_kernel kernel = kernels[i].stages[k].get();
-          set_stage_arguments(kernel, in, out, b.tables[stage.dimension], in_offset, lo, hi, last && slice > 0);
+          set_stage_arguments(kernel, in, out, b.tables[stage.dimension], placement);
           const std::uint64_t items = stage_work_items(stage, kernels[i].shape);
           const std::uint64_t items_per_part = items / split.parts.parts;
           const Range part = split.parts.parts == 1 ? Range{0, 1} : split.by_part.devices[i];
-          const std::size_t group = std::min(kGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
-          launch_range(devices[i].session.queue.get(), kernel, part.begin * items_per_part,
-                       part.end * items_per_part, group);
+          const std::size_t group =
+              std::min(kFactoredGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
+          launch_range(devices[i].session.queue.get(), kernel, part.begin * items_per_part, part.end * items_per_part,
+                       group);
           check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
         }
         finish_all(team);
-        if (!last && split.exchange)
-          team.exchange(split.by_entry, sizeof(double), exchanged, host_tensor.data(), true);
+        if (!last && split.exchange) team.exchange(split.by_entry, sizeof(double), exchanged, host_tensor.data(), true);
       }
     }
     if (splits[last_stage].exchange)
@@ -188,7 +180,7 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
       check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &b.values[1 - current].handle), "clSetKernelArg");
       check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &b.best_input.handle), "clSetKernelArg");
       check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &b.roles.handle), "clSetKernelArg");
-      const std::size_t group = std::min(kGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
+      const std::size_t group = std::min(kFactoredGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
       launch_range(devices[i].session.queue.get(), kernel, states.devices[i].begin, states.devices[i].end, group);
       check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
       exchanged[i] = b.values[1 - current].get();
@@ -196,7 +188,8 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
     }
     finish_all(team);
     team.exchange(states, sizeof(double), exchanged, host_values.data(), true);
-    team.exchange(states, sizeof(std::uint32_t), inputs, policy.input_index.data() + std::size_t(step) * n_states, false);
+    team.exchange(states, sizeof(std::uint32_t), inputs, policy.input_index.data() + std::size_t(step) * n_states,
+                  false);
     std::copy(host_values.begin(), host_values.begin() + std::ptrdiff_t(n_states),
               policy.values.begin() + std::ptrdiff_t(std::size_t(step) * n_states));
     current = 1 - current;
@@ -208,9 +201,9 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
       progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done,
                seconds_since(synthesis_start) / done * (a.horizon - done));
   }
-  (void)profile;
   rep.exchange_seconds = team.exchange_seconds();
-  rep.phases.push_back({"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+  rep.phases.push_back(
+      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
   return policy;
 }
 
@@ -221,8 +214,8 @@ std::vector<std::string> describe_factored_team(const Abstraction& a, const Fact
       "exchanged where the next stage needs the whole tensor (Q once per step)"};
   for (std::size_t k = 0; k < plan.stages.size(); ++k) {
     const StageSplit& split = splits[k];
-    std::string line = "stage " + std::to_string(k) + " (x'" + std::to_string(plan.stages[k].dimension) + "): " +
-                       std::to_string(plan.stages[k].output_size) + " entries (" +
+    std::string line = "stage " + std::to_string(k) + " (x'" + std::to_string(plan.stages[k].dimension) +
+                       "): " + std::to_string(plan.stages[k].output_size) + " entries (" +
                        format_bytes(8.0 * double(plan.stages[k].output_size)) + ")";
     if (split.parts.parts == 1) {
       line += ", not split (every device computes all: its vector digit is the major one)";
@@ -243,11 +236,12 @@ std::vector<std::string> describe_factored_team(const Abstraction& a, const Fact
   const Split states = team.split(a.states.size());
   for (const std::string& line : team.describe(states, "input choice, states")) lines.push_back(line);
   for (std::size_t i = 0; i < team.devices().size(); ++i)
-    lines.push_back("rank " + std::to_string(states.rank) + " device " + std::to_string(i) +
-                    ": device memory " + format_bytes(double(plan.device_bytes)) + " (whole tensors) of " +
+    lines.push_back("rank " + std::to_string(states.rank) + " device " + std::to_string(i) + ": device memory " +
+                    format_bytes(double(plan.device_bytes)) + " (whole tensors) of " +
                     format_bytes(double(team.devices()[i].info.global_memory)));
   lines.push_back("exchange per step: " + format_bytes(exchange_bytes_per_step(a, plan, splits)) + " (" +
-                  std::to_string(plan.slices) + " slice(s); stage tensors, Q, values and inputs), each device "
+                  std::to_string(plan.slices) +
+                  " slice(s); stage tensors, Q, values and inputs), each device "
                   "receiving the parts it did not compute");
   return lines;
 }

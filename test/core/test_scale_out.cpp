@@ -143,7 +143,8 @@ TEST(DeviceSelector, ParsesKindsIndicesAndParts) {
   const auto indexed = parse_device_selector("1.0");
   ASSERT_TRUE(indexed);
   EXPECT_EQ(indexed->platform, 1u);
-  for (const char* bad : {"gpu", "gpu:x", "tpu:0", "cpu:0/0", "1", "1.", ""}) EXPECT_FALSE(parse_device_selector(bad)) << bad;
+  for (const char* bad : {"gpu", "gpu:x", "tpu:0", "cpu:0/0", "1", "1.", ""})
+    EXPECT_FALSE(parse_device_selector(bad)) << bad;
 }
 
 TEST(DeviceSelector, ValidateNamesTheEntryAndAnExample) {
@@ -233,9 +234,10 @@ TEST(ScaleOutPlan, DryRunDescribesSlicesMemoryAndExchange) {
   options.compute.sweep = SweepChoice::Dense;
   const std::vector<std::string> lines = describe_scale_out(from_yaml(robot_yaml()), options);
   auto contains = [&](const std::string& fragment) {
-    return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(fragment) != std::string::npos; });
+    return std::any_of(lines.begin(), lines.end(),
+                       [&](const std::string& l) { return l.find(fragment) != std::string::npos; });
   };
-  EXPECT_TRUE(contains("device 0")) ;
+  EXPECT_TRUE(contains("device 0"));
   EXPECT_TRUE(contains("device 1"));
   EXPECT_TRUE(contains("states [0, "));
   EXPECT_TRUE(contains("exchange per step"));
