@@ -296,6 +296,11 @@ int run(const Options& options, cli::MpiSession& mpi) {
   print_memory_estimate(abstraction);
   std::printf("device: %s, transitions: %s\n", to_string(config.compute.device).c_str(),
               to_string(config.compute.transitions).c_str());
+  if (!config.compute.devices.empty()) {
+    std::string devices;
+    for (const std::string& entry : config.compute.devices) devices += (devices.empty() ? "" : ", ") + entry;
+    std::printf("devices: %s\n", devices.c_str());
+  }
   if (mpi.size() > 1) std::printf("MPI: %d ranks\n", mpi.size());
   std::fflush(stdout);
 
