@@ -16,6 +16,7 @@
 #include "opencl_program_cache.hpp"
 #include "opencl_run.hpp"
 #include "opencl_source.hpp"
+#include "team.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -38,6 +39,8 @@ void check_supported(const Abstraction& a) {
     throw ConfigError("states", "the OpenCL engine supports fewer than 2^32 state cells (got " +
                                     std::to_string(a.states.size()) + ")");
 }
+
+}  // namespace
 
 // The dense sweep's padded value array is indexed with 32 bits.
 void check_dense_supported(const Layout& layout) {
@@ -99,7 +102,9 @@ void unpad(double* out, const std::vector<std::size_t>& padded_index, const doub
   for (std::size_t x = 0; x < padded_index.size(); ++x) out[x] = padded[padded_index[x]];
 }
 
-}  // namespace
+void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded_index, const double* padded) {
+  unpad(policy.values.data() + std::size_t(step) * padded_index.size(), padded_index, padded);
+}
 
 Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, SynthesisReport* report,
                          const OpenClEngineOptions& engine_options) {
@@ -108,6 +113,13 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   SynthesisReport& rep = report ? *report : local_report;
   const Layout layout(a);
   check_supported(a);
+  if (is_scale_out(options)) {
+    if (a.unbounded)
+      throw ConfigError("spec.horizon", "infinite (interval iteration) runs on one OpenCL device or on compute.device: "
+                                        "reference; several devices (compute.devices) and MPI ranks compute bounded "
+                                        "horizons only (example: horizon: 16)");
+    return synthesize_team(a, options, rep, engine_options);
+  }
 
   auto phase_start = Clock::now();
   const DeviceInfo device = choose_device(options.compute, rep.notes);
@@ -159,8 +171,7 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
 
   // Synthesis (Algorithm 4), V_{T_d} -> V_0, one padded step at a time back to the host.
   Policy policy = empty_policy(a, device.label());
-  unpad(policy.values.data() + std::size_t(a.horizon) * a.states.size(), buffers.padded_index,
-        buffers.terminal.data());
+  unpad(policy, a.horizon, buffers.padded_index, buffers.terminal.data());
   std::vector<double> step_values(layout.padded_size);
   const double multiply_adds_per_step =
       double(buffers.free_states) * double(plan.records_per_state) * contraction_multiply_adds(a);
