@@ -178,6 +178,18 @@ TEST(Unbounded, OpenClAgreesWithReferenceOnARobot) {
   }
 }
 
+TEST(Unbounded, SeveralDevicesAreRefused) {
+  SynthesisOptions options;
+  options.compute.device = DeviceKind::Cpu;
+  options.compute.devices = {"all"};
+  try {
+    synthesize(from_yaml(kRuin), options);
+    ADD_FAILURE() << "an unbounded specification ran on several devices";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(error.key(), "spec.horizon") << error.what();
+  }
+}
+
 TEST(Unbounded, ConfigurationKeys) {
   const Config config = config_from_yaml(YAML::Load(kRuin));
   EXPECT_TRUE(config.spec.unbounded);
