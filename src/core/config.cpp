@@ -395,7 +395,7 @@ void Config::validate() const {
       try {
         Expression::parse(dynamics[i], constants, n, m, p);
       } catch (const ParseError& error) {
-        throw ConfigError(indexed("dynamics", i), std::string(error.what()) + " in \"" + dynamics[i] + "\"");
+        throw ConfigError(indexed("dynamics", i), std::string(error.what()) + " in \"" + expression_excerpt(dynamics[i]) + "\"");
       }
     }
   } else {
@@ -530,8 +530,11 @@ Config config_from_yaml(const YAML::Node& root) {
       {{"safety", SpecType::Safety}, {"reachability", SpecType::Reachability}, {"reach_avoid", SpecType::ReachAvoid}},
       "type: reach_avoid");
   const double horizon = read_number(required(spec, "horizon", "spec.horizon", "horizon: 16"), "spec.horizon", "horizon: 16");
-  if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= 1e9))
-    fail("spec.horizon", spec["horizon"].Scalar(), "an integer >= 1 (number of time steps)", "horizon: 16");
+  constexpr double kMaxHorizon = 1e9;  // the policy arrays' 16 GiB limit is checked in validate()
+  if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= kMaxHorizon))
+    fail("spec.horizon", spec["horizon"].Scalar(),
+         "an integer >= 1 and <= 1000000000 (number of time steps; the policy arrays must also fit in 16 GiB)",
+         "horizon: 16");
   config.spec.horizon = static_cast<unsigned>(horizon);
   if (present(spec["safe"])) config.spec.safe = read_box(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
   if (present(spec["target"])) config.spec.target = read_box(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
