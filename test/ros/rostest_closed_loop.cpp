@@ -4,7 +4,7 @@
 #include <fstream>
 #include <mutex>
 
-#include <amytiss/EpisodeSummary.h>
+#include <amytiss_msgs/EpisodeSummary.h>
 
 #include "rostest_support.hpp"
 
@@ -20,9 +20,9 @@ constexpr double kAbstractionGap = 0.05;
 TEST(ClosedLoop, MostEpisodesReachTheTargetConsistentWithV0) {
   ros::NodeHandle handle;
   std::mutex mutex;
-  amytiss::EpisodeSummary::ConstPtr summary;
-  ros::Subscriber subscriber = handle.subscribe<amytiss::EpisodeSummary>(
-      "/amytiss/episode_summary", 1, [&](const amytiss::EpisodeSummary::ConstPtr& message) {
+  amytiss_msgs::EpisodeSummary::ConstPtr summary;
+  ros::Subscriber subscriber = handle.subscribe<amytiss_msgs::EpisodeSummary>(
+      "/amytiss/episode_summary", 1, [&](const amytiss_msgs::EpisodeSummary::ConstPtr& message) {
         std::lock_guard<std::mutex> lock(mutex);
         summary = message;
       });
