@@ -21,7 +21,11 @@ foreach(node synthesizer policy_server plant_simulator)
   target_link_libraries(${node} amytiss_ros)
 endforeach()
 
-install(TARGETS amytiss_ros synthesizer policy_server plant_simulator
+# Load test client of the service (scripts/bench_service runs it).
+add_executable(bench_service src/tools/bench_service.cpp)
+target_link_libraries(bench_service amytiss_ros)
+
+install(TARGETS amytiss_ros synthesizer policy_server plant_simulator bench_service
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
