@@ -53,12 +53,4 @@ TEST(ClosedLoop, MostEpisodesReachTheTargetConsistentWithV0) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_closed_loop_test");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_closed_loop_test", 1); }

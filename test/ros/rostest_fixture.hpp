@@ -13,11 +13,19 @@
 namespace amytiss_test {
 
 constexpr double kActionWaitSeconds = 60.0;
+// A configuration big enough (about 0.1 s per step on the reference engine, 40 steps) to be
+// cancelled or killed while it runs.
+constexpr const char* kSlowConfig = R"YAML(
+name: slow_for_cancel
+states:  {lb: [-5, -5], ub: [5, 5], eta: [0.125, 0.125]}
+inputs:  {lb: [0, -3.2], ub: [1, 3.2], eta: [0.5, 0.4]}
+dynamics: ["x0 + u0*cos(u1)", "x1 + u0*sin(u1)"]
+noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncation: cutting_probability, cutting_probability: 1.0e-4}
+spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
+)YAML";
 
 class SynthesizerAndServerTest : public ::testing::Test {
  protected:
-  /// The state every call() asks about (inside the tiny_reach_avoid grid).
-  const std::vector<double> kState = {-4.0, -4.0};
 
   void SetUp() override {
     ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(kServiceWaitSeconds)));
@@ -28,11 +36,12 @@ class SynthesizerAndServerTest : public ::testing::Test {
         << status_.latest().message;
     ASSERT_TRUE(poll_until([&] { return call().success; }, kPolicyWaitSeconds));
   }
-  /// GetInput for kState at step 0 (the call itself must succeed; the answer may say no).
-  amytiss_msgs::GetInput::Response call() {
+  /// GetInput (the call itself must succeed; the answer may say no). The default state lies in
+  /// the tiny_reach_avoid grid.
+  amytiss_msgs::GetInput::Response call(const std::vector<double>& state = {-4.0, -4.0}, unsigned step = 0) {
     amytiss_msgs::GetInput service;
-    service.request.state = kState;
-    service.request.time_step = 0;
+    service.request.state = state;
+    service.request.time_step = step;
     EXPECT_TRUE(client_.call(service));
     return service.response;
   }

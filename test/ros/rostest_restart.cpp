@@ -17,15 +17,6 @@ namespace {
 
 constexpr double kNoticeWaitSeconds = 20.0;  // the server's synthesizer_timeout_s is 2
 const std::string kSynthesizer = "/amytiss/synthesizer";
-// About 0.1 s per step on the reference engine, 40 steps: long enough to be killed mid-run.
-const char* kSlowConfig = R"YAML(
-name: slow_for_kill
-states:  {lb: [-5, -5], ub: [5, 5], eta: [0.125, 0.125]}
-inputs:  {lb: [0, -3.2], ub: [1, 3.2], eta: [0.5, 0.4]}
-dynamics: ["x0 + u0*cos(u1)", "x1 + u0*sin(u1)"]
-noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncation: cutting_probability, cutting_probability: 1.0e-4}
-spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
-)YAML";
 
 // The process id of a node, asked through its XML-RPC API (as `rosnode info` does).
 int node_pid(const std::string& node) {
@@ -49,7 +40,7 @@ TEST_F(RestartTest, KilledSynthesizerIsReportedAndARestartedOneIsFollowedWithout
   const amytiss_msgs::PolicyStatus served = status_.latest();
   ASSERT_EQ(1u, served.generation) << "the scenario needs a synthesizer that announced one policy";
   amytiss_msgs::SynthesizeGoal slow;
-  slow.config_yaml = kSlowConfig;
+  slow.config_yaml = amytiss_test::kSlowConfig;
   slow.force = true;
   action_.sendGoal(slow);
   ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.synthesizing && s.percent > 0; },
@@ -102,12 +93,4 @@ TEST_F(RestartTest, KilledSynthesizerIsReportedAndARestartedOneIsFollowedWithout
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_rostest_restart");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_rostest_restart", 2); }

@@ -7,54 +7,15 @@
 #include <amytiss_msgs/SynthesizeAction.h>
 
 #include "amytiss/policy_file.hpp"
-#include "rostest_support.hpp"
+#include "rostest_fixture.hpp"
 
 namespace {
 
-constexpr double kActionWaitSeconds = 60.0;
 const std::string kSynthesizer = "/amytiss/synthesizer";
-// A configuration big enough (about 0.1 s per step on the reference engine, 40 steps) to be
-// cancelled while it runs.
-const char* kSlowConfig = R"YAML(
-name: slow_for_cancel
-states:  {lb: [-5, -5], ub: [5, 5], eta: [0.125, 0.125]}
-inputs:  {lb: [0, -3.2], ub: [1, 3.2], eta: [0.5, 0.4]}
-dynamics: ["x0 + u0*cos(u1)", "x1 + u0*sin(u1)"]
-noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncation: cutting_probability, cutting_probability: 1.0e-4}
-spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
-)YAML";
-
+using amytiss_test::kActionWaitSeconds;
+using amytiss_test::kSlowConfig;
 using Client = actionlib::SimpleActionClient<amytiss_msgs::SynthesizeAction>;
-
-class ResynthesisTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
-    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/false);
-    ASSERT_TRUE(action_.waitForServer(ros::Duration(amytiss_test::kServiceWaitSeconds)));
-    ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.ready && !s.synthesizing; },
-                                 amytiss_test::kPolicyWaitSeconds))
-        << status_.latest().message;
-    ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
-  }
-  amytiss_msgs::GetInput::Response call(const std::vector<double>& state, unsigned step) {
-    amytiss_msgs::GetInput service;
-    service.request.state = state;
-    service.request.time_step = step;
-    EXPECT_TRUE(client_.call(service));
-    return service.response;
-  }
-  amytiss_msgs::SynthesizeResult run_goal(const amytiss_msgs::SynthesizeGoal& goal) {
-    action_.sendGoal(goal);
-    EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
-    return *action_.getResult();
-  }
-
-  ros::NodeHandle handle_;
-  amytiss_test::StatusWatcher status_{handle_};
-  ros::ServiceClient client_;
-  Client action_{"/amytiss/synthesize", true};
-};
+using ResynthesisTest = amytiss_test::SynthesizerAndServerTest;
 
 TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
   const amytiss_msgs::PolicyStatus before = status_.latest();
@@ -165,12 +126,4 @@ TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_resynthesis_test");
-  ros::AsyncSpinner spinner(3);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_resynthesis_test", 3); }

@@ -127,12 +127,4 @@ TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_service_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_service_test", 2); }

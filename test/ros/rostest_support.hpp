@@ -42,6 +42,18 @@ class StatusWatcher {
   ros::Subscriber subscriber_;
 };
 
+/// main() of a rostest: gtest, a node named `node_name`, `threads` spinner threads for the
+/// subscriptions and action clients of the tests.
+inline int run_rostests(int argc, char** argv, const char* node_name, unsigned threads) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, node_name);
+  ros::AsyncSpinner spinner(threads);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  ros::shutdown();
+  return result;
+}
+
 /// Polls `condition` every kPollPeriodSeconds for at most `seconds`.
 inline bool poll_until(const std::function<bool()>& condition, double seconds) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
