@@ -7,7 +7,7 @@
 //   FixedOne:  V_k(x) = 1 for all k      (reach: the target G)
 //   FixedZero: V_k(x) = 0 for all k      (avoid set A; safety: cells outside S)
 // Terminal values V_{T_d}: safety 1 on Free cells; reach(-avoid) 0 on Free cells. Mass leaving
-// the grid counts 0. This is exactly SPEC section 2's definitions (for reach-avoid, G counts 1
+// the grid counts 0. This is exactly the paper's definitions (docs/semantics.md; for reach-avoid, G counts 1
 // and A counts 0 inside the sum, and V = 1 on G, 0 on A).
 #include <cstdint>
 #include <memory>

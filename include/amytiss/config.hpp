@@ -1,5 +1,5 @@
 #pragma once
-// The one configuration of a synthesis problem (SPEC section 3). The same schema is read from a
+// The one configuration of a synthesis problem (docs/configuration.md). The same schema is read from a
 // YAML file (CLI) and from ROS parameters (the ROS layer converts its XmlRpc tree to YAML::Node).
 #include <cstdint>
 #include <map>
@@ -79,7 +79,8 @@ struct Config {
   SpecConfig spec;
   ComputeConfig compute;
 
-  /// Throws ConfigError for the first problem found (SPEC section 7): dimensions that disagree,
+  /// The only place that judges user input (docs/configuration.md, "Checks"). Throws
+  /// ConfigError for the first problem found: dimensions that disagree,
   /// eta <= 0, lb > ub, covariance not symmetric positive definite, expression that does not
   /// parse (with column), unknown model, set outside the grid, horizon 0, grid too large.
   void validate() const;

@@ -12,8 +12,13 @@ namespace amytiss {
 
 /// Progress of a running synthesis, reported after set-up, after construction and after each
 /// time step.
+/// Phases of a synthesis, in order; names (to_string) as published in PolicyStatus.phase and the
+/// Synthesize action's feedback: "setup", "construction", "synthesis", "done".
+enum class Phase { Setup, Construction, Synthesis, Done };
+std::string to_string(Phase phase);
+
 struct Progress {
-  std::string phase;          ///< "setup", "construction", "synthesis", "done"
+  Phase phase = Phase::Setup;
   unsigned steps_done = 0;    ///< time steps of the backward recursion finished
   unsigned steps_total = 0;   ///< the horizon
   std::string device;         ///< device name, or "reference"
@@ -31,13 +36,34 @@ struct PhaseReport {
   double pairs_per_second = 0; ///< state-input pairs processed per second (0 if not applicable)
   double multiply_adds = 0;    ///< multiply-adds done in the phase (0 if not counted)
 };
+/// How much an engine note matters: Info is a fact about the run (storage chosen, memory used);
+/// Warning says the run differs from what was asked (another device, on-the-fly storage).
+enum class NoteSeverity { Info, Warning };
+/// What an engine note is about.
+enum class NoteKind {
+  DeviceChoice,    ///< which device was chosen, or skipped and why
+  DeviceFallback,  ///< a device other than the one asked for runs the synthesis
+  Transitions,     ///< transition storage (stored or on the fly) and why
+  Sweep,           ///< work decomposition of the synthesis sweep
+  Chunking,        ///< states split into chunks (allocation limits)
+  DeviceMemory,    ///< device memory allocated
+  KernelBuild      ///< program built from source or loaded from the binary cache
+};
+std::string to_string(NoteSeverity severity);
+std::string to_string(NoteKind kind);
+struct EngineNote {
+  NoteSeverity severity = NoteSeverity::Info;
+  NoteKind kind = NoteKind::DeviceChoice;
+  std::string text;  ///< a sentence for people, without a severity prefix
+};
+
 struct SynthesisReport {
   std::string device;                 ///< "reference" or "<platform> / <device>"
   std::string transitions;            ///< "stored" or "on_the_fly", with the reason
   std::vector<PhaseReport> phases;
   std::size_t device_bytes = 0;       ///< peak device memory allocated by the engine
   std::size_t host_peak_bytes = 0;    ///< peak resident set of the process (VmHWM)
-  std::vector<std::string> log;       ///< notes: device fallback reason, chunking, ...
+  std::vector<EngineNote> notes;      ///< device choice and fallback, storage, chunking, ...
 };
 
 struct SynthesisOptions {
@@ -47,10 +73,22 @@ struct SynthesisOptions {
 };
 
 /// Runs the engine named by options.compute.device. `auto` prefers a GPU, else the CPU OpenCL
-/// device, else throws DeviceError; `cpu`/`gpu` that are missing fall back to the CPU device with a
-/// note in report->log (SPEC section 7). Throws Cancelled, DeviceError, ConfigError.
+/// device, else throws DeviceError; `cpu`/`gpu` that are missing use another OpenCL device, and
+/// a device that fails (DeviceError) is retried once on the CPU device, each with a Warning
+/// DeviceFallback note in report->notes (docs/engine.md). Throws Cancelled, DeviceError,
+/// ConfigError.
 Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
                   SynthesisReport* report = nullptr);
+
+/// Memory a synthesis needs, in bytes, as the OpenCL engine lays it out (docs/engine.md).
+struct MemoryEstimate {
+  double policy_bytes = 0;             ///< policy arrays as in the file: float64 values of every
+                                       ///< step, uint32 input indices, uint8 roles
+  double bytes_per_triple = 0;         ///< one stored transition record: uint32 window offset +
+                                       ///< float32 cell masses of every dimension's window
+  double stored_transition_bytes = 0;  ///< bytes_per_triple times the state-input-disturbance triples
+};
+MemoryEstimate estimate_memory(const Abstraction& abstraction);
 
 /// The serial reference engine directly.
 Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallback& progress,

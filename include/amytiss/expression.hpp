@@ -1,5 +1,5 @@
 #pragma once
-// Dynamics expressions (SPEC section 3): a whitelisted grammar, evaluated in C++ and emitted as
+// Dynamics expressions (docs/configuration.md): a whitelisted grammar, evaluated in C++ and emitted as
 // OpenCL C. Nothing outside the grammar is accepted, so no parameter text reaches a compiler.
 //
 // Grammar (precedence low to high):
@@ -46,7 +46,7 @@ class Expression {
   double evaluate(const double* x, const double* u, const double* w) const;
 
   /// OpenCL C (and C++) expression text over arrays named `x`, `u`, `w` of type double; numbers
-  /// are printed with 17 significant digits. Example: "(x[0] + (10.0 * (u[0] * cos(u[1]))))".
+  /// are printed as c_double_literal() (format.hpp): the shortest text that reads back exactly. Example: "(x[0] + (10.0 * (u[0] * cos(u[1]))))".
   std::string to_c() const;
 
   const std::string& text() const { return text_; }

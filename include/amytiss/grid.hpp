@@ -1,5 +1,5 @@
 #pragma once
-// Uniform grids (SPEC section 2). Flat indices are row-major: the LAST dimension varies fastest,
+// Uniform grids (docs/semantics.md). Flat indices are row-major: the LAST dimension varies fastest,
 // flat = ((k0*n1 + k1)*n2 + k2)..., so a flat value array reshapes to numpy's (n0, n1, ...).
 // A grid with zero dimensions has exactly one (empty) point: autonomous systems, no disturbance.
 #include <cstddef>

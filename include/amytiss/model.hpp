@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/expression.hpp"
 
 namespace amytiss {
 
@@ -24,9 +25,14 @@ class Dynamics {
   virtual std::string describe() const = 0;
 };
 
-/// Builds the dynamics of a validated configuration: expressions, or the built-in `model`.
-/// Throws ConfigError (key "dynamics[i]" with the parse column, or "model").
+/// Builds the dynamics of a validated configuration (Config::validate()): expressions, or the
+/// built-in `model`. A configuration validate() would refuse is a caller bug: std::logic_error
+/// (ConfigError "dynamics[i]" from parse_dynamics() for an expression that does not parse).
 std::unique_ptr<Dynamics> make_dynamics(const Config& config);
+/// The dynamics expressions of `config` parsed, one per state dimension: the one place they are
+/// parsed (Config::validate() and make_dynamics() both call it). Throws ConfigError naming
+/// dynamics[i] with the parser's message.
+std::vector<Expression> parse_dynamics(const Config& config);
 
 /// Names of the built-in models ("bmw320i", "vehicle3d") and their dimensions.
 struct BuiltinModelInfo {

@@ -1,5 +1,5 @@
 #pragma once
-// Noise and exact transition probabilities (SPEC section 2).
+// Noise and exact transition probabilities (docs/semantics.md).
 //
 // T(x' | x,u,w) = P( f(x,u,w) + noise in cell(x') ), cell(x') = [x' - eta/2, x' + eta/2].
 // Separable noise (normal with diagonal covariance, uniform) gives T as a product of
@@ -21,6 +21,7 @@
 // Multiplicative noise: noise_i scales with |x_i| of the current state (diagonal only).
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "amytiss/config.hpp"
@@ -33,7 +34,9 @@ class NoiseModel {
   static constexpr std::size_t kMaxFullCovarianceDims = 4;
   static constexpr std::size_t kGaussLegendreOrder = 8;
 
-  /// Throws ConfigError for a covariance that is not symmetric positive definite, etc.
+  /// `config` must have passed Config::validate() for these states (sizes, symmetric positive
+  /// definite covariance, positive half-widths, truncation parameters); the constructor asserts
+  /// it (std::logic_error), it does not judge user input.
   NoiseModel(const NoiseConfig& config, const Grid& states);
 
   std::size_t dims() const { return dims_; }
@@ -69,7 +72,7 @@ class NoiseModel {
                    double* out) const;
 
   /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
-  /// bound documented in noise.cpp and README ("Full covariance"); |error| <= box_mass_tolerance().
+  /// bound in noise.cpp and docs/semantics.md ("Transition probabilities"); |error| <= box_mass_tolerance().
   /// Method: sequential conditioning x = mean + L z (L Cholesky, z standard normal), nested
   /// composite Gauss-Legendre over z_0..z_{n-2} (panel width <= 1 standard deviation, narrowed
   /// where later bounds depend steeply on z_i), exact erfc for z_{n-1}, z clipped to |z| <= 9.
@@ -114,9 +117,9 @@ class NoiseModel {
 };
 
 /// Lower-triangular Cholesky factor L (row-major n*n, matrix = L L^T) of a symmetric n*n matrix
-/// (row-major, only its lower triangle is read). Throws ConfigError (key noise.covariance) when
-/// the matrix is not positive definite.
-std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size_t n);
+/// (row-major, only its lower triangle is read); nothing when the matrix is not positive
+/// definite (a pivot <= 0). Config::validate() refuses such a covariance with this same function.
+std::optional<std::vector<double>> cholesky_factor(const std::vector<double>& matrix, std::size_t n);
 /// Standard normal upper tail quantile: z with 1 - Phi(z) = p, for p in (0, 0.5].
 double normal_upper_quantile(double p);
 

@@ -1,5 +1,5 @@
 #pragma once
-// The synthesized time-varying policy u*(x, k) and the values V_k(x) (SPEC section 2).
+// The synthesized time-varying policy u*(x, k) and the values V_k(x) (docs/semantics.md).
 #include <cstddef>
 #include <cstdint>
 #include <string>

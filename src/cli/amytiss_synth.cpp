@@ -12,6 +12,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
+#include "amytiss/enum_names.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/policy.hpp"
 #include "amytiss/policy_file.hpp"
@@ -28,7 +29,7 @@ constexpr const char* kUsage =
     "an HDF5 policy file (docs/policy_file.md).\n"
     "\n"
     "options:\n"
-    "  --config FILE                      YAML configuration (SPEC section 3)\n"
+    "  --config FILE                      YAML configuration (docs/configuration.md)\n"
     "  --device auto|cpu|gpu|reference    overrides compute.device\n"
     "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
@@ -86,17 +87,10 @@ Options parse_options(int argc, char** argv) {
   return options;
 }
 
-DeviceKind parse_device(const std::string& text) {
-  for (DeviceKind kind : {DeviceKind::Auto, DeviceKind::Cpu, DeviceKind::Gpu, DeviceKind::Reference})
-    if (text == to_string(kind)) return kind;
-  throw UsageError("--device: got '" + text + "', expected auto, cpu, gpu or reference");
-}
-
-TransitionStorage parse_transitions(const std::string& text) {
-  for (TransitionStorage storage :
-       {TransitionStorage::Auto, TransitionStorage::Stored, TransitionStorage::OnTheFly})
-    if (text == to_string(storage)) return storage;
-  throw UsageError("--transitions: got '" + text + "', expected auto, stored or on_the_fly");
+template <typename Enum>
+Enum parse_enum_option(const std::string& option, const std::string& text) {
+  if (const auto value = enum_from_name<Enum>(text)) return *value;
+  throw UsageError(option + ": got '" + text + "', expected one of " + enum_name_list<Enum>());
 }
 
 double seconds_since(Clock::time_point start) {
@@ -138,31 +132,17 @@ void print_sizes(const Abstraction& abstraction) {
               abstraction.pairs(), abstraction.triples(), abstraction.horizon);
 }
 
-// Bytes of the policy arrays (as in the file) and of stored transitions, as the OpenCL engine
-// stores them (docs/engine.md): per triple, the padded offset of the window (uint32) and the
-// per-dimension cell masses (float32) of a window of 2*min(h, n-1)+1 cells, or n for a whole-grid
-// dimension.
+// The engine's estimate (docs/engine.md): policy arrays as in the file, stored transitions as
+// the OpenCL engine stores them.
 void print_memory_estimate(const Abstraction& abstraction) {
-  const double cells = double(abstraction.states.size());
-  const double horizon = double(abstraction.horizon);
-  const double policy_bytes = (horizon + 1) * cells * sizeof(double) +
-                              horizon * cells * sizeof(std::uint32_t) + cells;
-  double masses_per_triple = 0;
-  const auto& half_cells = abstraction.noise->window_half_cells();
-  const auto& whole_grid = abstraction.noise->whole_grid_dims();
-  for (std::size_t dim = 0; dim < half_cells.size(); ++dim) {
-    const auto count = std::int64_t(abstraction.states.count(dim));
-    masses_per_triple += double(whole_grid[dim] ? count : 2 * std::min(half_cells[dim], count - 1) + 1);
-  }
-  const double bytes_per_triple = 4.0 + 4.0 * masses_per_triple;
+  const MemoryEstimate estimate = estimate_memory(abstraction);
   std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",
-              format_bytes(policy_bytes).c_str(),
-              format_bytes(bytes_per_triple * double(abstraction.triples())).c_str(),
-              bytes_per_triple);
+              format_bytes(estimate.policy_bytes).c_str(), format_bytes(estimate.stored_transition_bytes).c_str(),
+              estimate.bytes_per_triple);
 }
 
 bool print_progress(const Progress& progress, bool quiet) {
-  if (quiet || progress.phase != "synthesis") return true;
+  if (quiet || progress.phase != Phase::Synthesis) return true;
   std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
               progress.steps_total, progress.percent(), progress.device.c_str(),
               format_seconds(progress.elapsed_s).c_str());
@@ -263,9 +243,9 @@ int run(const Options& options) {
 
   const auto setup_start = Clock::now();
   Config config = load_config_file(options.config_path);
-  if (!options.device.empty()) config.compute.device = parse_device(options.device);
+  if (!options.device.empty()) config.compute.device = parse_enum_option<DeviceKind>("--device", options.device);
   if (!options.transitions.empty())
-    config.compute.transitions = parse_transitions(options.transitions);
+    config.compute.transitions = parse_enum_option<TransitionStorage>("--transitions", options.transitions);
   if (!options.platform.empty()) config.compute.platform = options.platform;
   const Abstraction abstraction = Abstraction::from_config(config);
   const double setup_seconds = seconds_since(setup_start);
@@ -290,7 +270,8 @@ int run(const Options& options) {
   const auto synthesis_start = Clock::now();
   const Policy policy = synthesize(abstraction, synthesis_options, &report);
   const double synthesis_wall_seconds = seconds_since(synthesis_start);
-  for (const auto& note : report.log) std::printf("note: %s\n", note.c_str());
+  for (const auto& note : report.notes)
+    std::printf("note: %s%s\n", note.severity == NoteSeverity::Warning ? "warning: " : "", note.text.c_str());
   std::printf("computed by %s, transitions %s\n", report.device.c_str(),
               report.transitions.c_str());
 

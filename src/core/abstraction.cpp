@@ -1,5 +1,6 @@
 #include "amytiss/abstraction.hpp"
 
+#include <stdexcept>
 #include <string>
 
 #include "amytiss/errors.hpp"
@@ -7,11 +8,13 @@
 namespace amytiss {
 namespace {
 
-void check_box(const Box& box, std::size_t dims, const std::string& key) {
-  if (box.lb.size() != dims || box.ub.size() != dims)
-    throw ConfigError(key, "lb and ub have " + std::to_string(box.lb.size()) + " and " +
-                               std::to_string(box.ub.size()) + " values, expected " +
-                               std::to_string(dims) + " each (one per state dimension)");
+// Inputs here passed Config::validate(); a violation is a bug of the caller.
+void require(bool invariant, const std::string& what) {
+  if (!invariant) throw std::logic_error("Abstraction: expected a validated configuration: " + what);
+}
+
+void require_box(const Box& box, std::size_t dims) {
+  require(box.lb.size() == dims && box.ub.size() == dims, "boxes with one bound per state dimension");
 }
 
 }  // namespace
@@ -22,19 +25,17 @@ std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
   switch (spec.type) {
     case SpecType::Safety:
       if (spec.safe) {
-        check_box(*spec.safe, dims, "spec.safe");
+        require_box(*spec.safe, dims);
         for (std::size_t cell = 0; cell < roles.size(); ++cell)
           if (!states.point_in_box(cell, *spec.safe)) roles[cell] = CellRole::FixedZero;
       }
       break;
     case SpecType::Reachability:
     case SpecType::ReachAvoid: {
-      if (!spec.target)
-        throw ConfigError("spec.target", "missing, expected a box for " + to_string(spec.type) +
-                                             " (example: target: {lb: [5, 5], ub: [7, 7]})");
-      check_box(*spec.target, dims, "spec.target");
+      require(spec.target.has_value(), "a target box for reachability and reach_avoid");
+      require_box(*spec.target, dims);
       const bool with_avoid = spec.type == SpecType::ReachAvoid && spec.avoid.has_value();
-      if (with_avoid) check_box(*spec.avoid, dims, "spec.avoid");
+      if (with_avoid) require_box(*spec.avoid, dims);
       for (std::size_t cell = 0; cell < roles.size(); ++cell) {
         if (with_avoid && states.point_in_box(cell, *spec.avoid))
           roles[cell] = CellRole::FixedZero;
@@ -57,25 +58,16 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
   Abstraction abstraction;
   abstraction.config = config;
   abstraction.states = Grid(config.states);
-  if (abstraction.states.dims() == 0)
-    throw ConfigError("states", "no dimensions, expected at least one (example: lb: [-10], ub: [10], eta: [0.5])");
+  require(abstraction.states.dims() > 0, "at least one state dimension");
   if (config.inputs) abstraction.inputs = Grid(*config.inputs);
   if (config.disturbances) abstraction.disturbances = Grid(*config.disturbances);
-  if (!dynamics) throw ConfigError("dynamics", "no dynamics given");
-  if (dynamics->state_dims() != abstraction.states.dims() ||
-      dynamics->input_dims() != abstraction.inputs.dims() ||
-      dynamics->disturbance_dims() != abstraction.disturbances.dims())
-    throw ConfigError("dynamics", "the dynamics has " + std::to_string(dynamics->state_dims()) + "/" +
-                                      std::to_string(dynamics->input_dims()) + "/" +
-                                      std::to_string(dynamics->disturbance_dims()) +
-                                      " state/input/disturbance dimensions, the grids have " +
-                                      std::to_string(abstraction.states.dims()) + "/" +
-                                      std::to_string(abstraction.inputs.dims()) + "/" +
-                                      std::to_string(abstraction.disturbances.dims()));
+  require(dynamics != nullptr, "a dynamics");
+  require(dynamics->state_dims() == abstraction.states.dims() && dynamics->input_dims() == abstraction.inputs.dims() &&
+              dynamics->disturbance_dims() == abstraction.disturbances.dims(),
+          "a dynamics with the grids' state, input and disturbance dimensions");
   abstraction.dynamics = std::move(dynamics);
   abstraction.noise = std::make_shared<NoiseModel>(config.noise, abstraction.states);
-  if (config.spec.horizon == 0)
-    throw ConfigError("spec.horizon", "got 0, expected a positive number of steps (example: horizon: 16)");
+  require(config.spec.horizon > 0, "a horizon of at least one step");
   abstraction.spec = config.spec.type;
   abstraction.horizon = config.spec.horizon;
   abstraction.roles = cell_roles(abstraction.states, config.spec);

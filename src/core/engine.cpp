@@ -1,4 +1,5 @@
-// synthesize(): dispatch to the reference or the OpenCL engine, with the CPU fallback of SPEC 7.
+// synthesize(): dispatch to the reference or the OpenCL engine, with the CPU fallback of
+// docs/engine.md (a failing device is retried once on the CPU device).
 #include "amytiss/engine.hpp"
 
 #include "amytiss/errors.hpp"
@@ -24,11 +25,11 @@ Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisRe
     // Running the device that just failed again would only fail again.
     if (fallback_device.empty() || fallback_device == first_report.device) throw;
     SynthesisReport retry_report;
-    retry_report.log = first_report.log;
-    retry_report.log.push_back("warning: " + (first_report.device.empty() ? std::string("the device")
-                                                                          : first_report.device) +
-                               " failed (" + failure.what() + "); falling back to the CPU device " +
-                               fallback_device);
+    retry_report.notes = first_report.notes;
+    retry_report.notes.push_back({NoteSeverity::Warning, NoteKind::DeviceFallback,
+                                  (first_report.device.empty() ? std::string("the device") : first_report.device) +
+                                      " failed (" + failure.what() + "); falling back to the CPU device " +
+                                      fallback_device});
     SynthesisOptions retry_options = options;
     retry_options.compute = on_cpu;
     Policy policy = attempt(retry_options, &retry_report);
@@ -44,7 +45,7 @@ namespace {
 Policy synthesize_on_device(const Abstraction& abstraction, const SynthesisOptions& options,
                             SynthesisReport* report) {
   if (options.compute.device == DeviceKind::Reference) {
-    if (report) report->log.push_back("device: reference (serial, double precision)");
+    if (report) report->notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device: reference (serial, double precision)"});
     return synthesize_reference(abstraction, options.progress, report);
   }
   return detail::synthesize_with_cpu_fallback(

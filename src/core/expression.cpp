@@ -1,5 +1,7 @@
 #include "amytiss/expression.hpp"
 
+#include "amytiss/format.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <algorithm>
@@ -578,10 +580,7 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
 }
 
 std::string c_number(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  std::string text = buffer;
-  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  std::string text = c_double_literal(value);
   if (value < 0) text = "(" + text + ")";
   return text;
 }

@@ -1,5 +1,7 @@
 #include "amytiss/grid.hpp"
 
+#include <stdexcept>
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -14,9 +16,9 @@ std::size_t grid_count(double lb, double ub, double eta) {
 
 Grid::Grid(const GridSpec& spec) {
   const std::size_t dims = spec.lb.size();
-  // Config::validate reports these with the exact key; this guards direct construction.
+  // The spec passed Config::validate() (which names the key); a violation is a bug of the caller.
   if (spec.ub.size() != dims || spec.eta.size() != dims)
-    throw ConfigError("grid", "lb, ub and eta have " + std::to_string(dims) + ", " +
+    throw std::logic_error("Grid: expected a validated grid: " + std::string() + "lb, ub and eta have " + std::to_string(dims) + ", " +
                                   std::to_string(spec.ub.size()) + " and " +
                                   std::to_string(spec.eta.size()) +
                                   " values, expected the same number");
@@ -27,15 +29,15 @@ Grid::Grid(const GridSpec& spec) {
   size_ = 1;
   for (std::size_t d = 0; d < dims; ++d) {
     if (!(std::isfinite(spec.lb[d]) && std::isfinite(spec.ub[d]) && std::isfinite(spec.eta[d])))
-      throw ConfigError("grid", "dimension " + std::to_string(d) + " has a bound or eta that is not finite");
+      throw std::logic_error("Grid: expected a validated grid: " + std::string() + "dimension " + std::to_string(d) + " has a bound or eta that is not finite");
     if (!(spec.eta[d] > 0))
-      throw ConfigError("grid", "eta[" + std::to_string(d) + "] = " + std::to_string(spec.eta[d]) +
+      throw std::logic_error("Grid: expected a validated grid: " + std::string() + "eta[" + std::to_string(d) + "] = " + std::to_string(spec.eta[d]) +
                                     ", expected a positive number");
     if (spec.lb[d] > spec.ub[d])
-      throw ConfigError("grid", "lb[" + std::to_string(d) + "] > ub[" + std::to_string(d) + "]");
+      throw std::logic_error("Grid: expected a validated grid: " + std::string() + "lb[" + std::to_string(d) + "] > ub[" + std::to_string(d) + "]");
     const double count = std::floor((spec.ub[d] - spec.lb[d]) / spec.eta[d] + 0.5) + 1;
     if (count > 1e15 || double(size_) * count > 1e18)
-      throw ConfigError("grid", "the grid has more points than can be indexed");
+      throw std::logic_error("Grid: expected a validated grid: " + std::string() + "the grid has more points than can be indexed");
     counts_[d] = grid_count(spec.lb[d], spec.ub[d], spec.eta[d]);
     size_ *= counts_[d];
   }

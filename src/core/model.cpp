@@ -2,8 +2,11 @@
 
 #include <math.h>
 
+#include <stdexcept>
+
 #include "amytiss/errors.hpp"
 #include "amytiss/expression.hpp"
+#include "embedded_sources.hpp"
 
 namespace amytiss {
 namespace builtin {
@@ -12,10 +15,6 @@ namespace builtin {
 #include "models/bmw320i.h"
 #include "models/vehicle3d.h"
 }  // namespace builtin
-
-namespace detail {
-const char* embedded_source(const std::string& name);
-}
 
 namespace {
 
@@ -99,33 +98,37 @@ std::unique_ptr<Dynamics> make_dynamics(const Config& config) {
   const std::size_t n = config.states.lb.size();
   const std::size_t m = config.inputs ? config.inputs->lb.size() : 0;
   const std::size_t p = config.disturbances ? config.disturbances->lb.size() : 0;
+  // The configuration passed Config::validate(); a violation is a bug of the caller.
+  const auto require = [](bool invariant, const std::string& what) {
+    if (!invariant) throw std::logic_error("make_dynamics: expected a validated configuration: " + what);
+  };
   if (!config.model.empty()) {
     for (const auto& info : builtin_models()) {
       if (info.name != config.model) continue;
-      if (info.state_dims != n || info.input_dims != m || info.disturbance_dims != p)
-        throw ConfigError("model", "model " + info.name + " needs " + std::to_string(info.state_dims) + " states, " +
-                                       std::to_string(info.input_dims) + " inputs and " +
-                                       std::to_string(info.disturbance_dims) + " disturbances, the grids have " +
-                                       std::to_string(n) + ", " + std::to_string(m) + " and " + std::to_string(p));
+      require(info.state_dims == n && info.input_dims == m && info.disturbance_dims == p,
+              "grids with the dimensions of model " + info.name);
       return std::make_unique<BuiltinDynamics>(info, builtin_function(info.name));
     }
-    std::string names;
-    for (const auto& info : builtin_models()) names += (names.empty() ? "" : ", ") + info.name;
-    throw ConfigError("model", "got '" + config.model + "', expected one of " + names + " (example: model: bmw320i)");
+    require(false, "a built-in model name, got '" + config.model + "'");
   }
-  if (config.dynamics.size() != n)
-    throw ConfigError("dynamics", "got " + std::to_string(config.dynamics.size()) + " expressions, expected " +
-                                      std::to_string(n) + ", one per state dimension");
+  require(config.dynamics.size() == n, "one dynamics expression per state dimension");
+  return std::make_unique<ExpressionDynamics>(parse_dynamics(config), m, p);
+}
+
+std::vector<Expression> parse_dynamics(const Config& config) {
+  const std::size_t n = config.states.lb.size();
+  const std::size_t m = config.inputs ? config.inputs->lb.size() : 0;
+  const std::size_t p = config.disturbances ? config.disturbances->lb.size() : 0;
   std::vector<Expression> expressions;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < config.dynamics.size(); ++i) {
     try {
       expressions.push_back(Expression::parse(config.dynamics[i], config.constants, n, m, p));
     } catch (const ParseError& error) {
       throw ConfigError("dynamics[" + std::to_string(i) + "]",
-                        std::string(error.what()) + " in \"" + config.dynamics[i] + "\"");
+                        std::string(error.what()) + " in \"" + expression_excerpt(config.dynamics[i]) + "\"");
     }
   }
-  return std::make_unique<ExpressionDynamics>(std::move(expressions), m, p);
+  return expressions;
 }
 
 }  // namespace amytiss

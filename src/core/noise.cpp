@@ -7,6 +7,7 @@
 #include <string>
 
 #include "amytiss/errors.hpp"
+#include "amytiss/format.hpp"
 
 namespace amytiss {
 namespace {
@@ -68,15 +69,14 @@ void gauss_legendre(std::size_t order, std::vector<double>& nodes, std::vector<d
   }
 }
 
-std::string number(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
+// The constructor's input passed Config::validate(); a violation is a bug of the caller.
+void require(bool invariant, const char* what) {
+  if (!invariant) throw std::logic_error(std::string("NoiseModel: expected a validated configuration: ") + what);
 }
 
 }  // namespace
 
-std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size_t n) {
+std::optional<std::vector<double>> cholesky_factor(const std::vector<double>& matrix, std::size_t n) {
   std::vector<double> factor(n * n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = 0; j <= i; ++j) {
@@ -84,12 +84,7 @@ std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size
       for (std::size_t k = 0; k < j; ++k) sum -= factor[i * n + k] * factor[j * n + k];
       if (i == j) {
         // A non-positive (or NaN) pivot means the matrix is not positive definite.
-        if (!(sum > 0))
-          throw ConfigError("noise.covariance",
-                            "the matrix is not positive definite (pivot " + std::to_string(i) + " is " +
-                                number(sum) +
-                                "); expected positive variances (example: covariance: [0.75, 0.75]; a "
-                                "dimension without noise needs the diagonal form with variance 0)");
+        if (!(sum > 0)) return std::nullopt;
         factor[i * n + i] = std::sqrt(sum);
       } else {
         factor[i * n + j] = sum / factor[j * n + j];
@@ -101,7 +96,7 @@ std::vector<double> cholesky_factor(const std::vector<double>& matrix, std::size
 
 double normal_upper_quantile(double p) {
   if (!(p > 0.0 && p <= 0.5))
-    throw std::invalid_argument("normal_upper_quantile: p = " + number(p) + ", expected 0 < p <= 0.5");
+    throw std::invalid_argument("normal_upper_quantile: p = " + format_number(p) + ", expected 0 < p <= 0.5");
   // Acklam's rational approximation of the lower quantile x = Phi^{-1}(p) (relative error
   // 1.15e-9), then one Halley step on erfc; z = -x.
   static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
@@ -141,46 +136,25 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
       counts_(states.counts()),
       grid_size_(states.size()) {
   const std::size_t n = dims_;
-  const std::string dims_text = std::to_string(n);
   if (distribution_ == Distribution::Normal) {
     const auto& cov = config.covariance;
-    if (cov.size() != n && cov.size() != n * n)
-      throw ConfigError("noise.covariance",
-                        "got " + std::to_string(cov.size()) + " values, expected " + dims_text +
-                            " (diagonal) or " + std::to_string(n * n) +
-                            " (full matrix, row-major) (example: covariance: [0.75, 0.75])");
-    for (std::size_t i = 0; i < cov.size(); ++i)
-      if (!std::isfinite(cov[i]))
-        throw ConfigError("noise.covariance", "value " + std::to_string(i) + " is not finite");
+    require(cov.size() == n || cov.size() == n * n, "covariance of n or n*n values");
     covariance_.assign(n * n, 0.0);
     // The diagonal form (n values) may give a variance of exactly 0: that dimension has no noise
-    // (a point mass). A full matrix must be positive definite for the conditioning quadrature.
+    // (a point mass). A full matrix is positive definite for the conditioning quadrature.
     const bool diagonal_form = cov.size() == n;
     if (diagonal_form) {
       for (std::size_t i = 0; i < n; ++i) {
-        if (!(cov[i] >= 0))
-          throw ConfigError("noise.covariance", "variance " + std::to_string(i) + " is " + number(cov[i]) +
-                                                    ", expected a number >= 0 (0: no noise in that dimension)");
+        require(cov[i] >= 0, "variances >= 0");
         covariance_[i * n + i] = cov[i];
       }
-    } else {
-      covariance_ = cov;
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < i; ++j) {
-        const double scale = std::sqrt(std::fabs(covariance_[i * n + i] * covariance_[j * n + j]));
-        if (std::fabs(covariance_[i * n + j] - covariance_[j * n + i]) > 1e-12 * std::max(scale, 1e-300))
-          throw ConfigError("noise.covariance", "the matrix is not symmetric: entry (" + std::to_string(i) +
-                                                    "," + std::to_string(j) + ") = " +
-                                                    number(covariance_[i * n + j]) + " but (" +
-                                                    std::to_string(j) + "," + std::to_string(i) +
-                                                    ") = " + number(covariance_[j * n + i]));
-      }
-    if (diagonal_form) {
       cholesky_.assign(n * n, 0.0);
       for (std::size_t i = 0; i < n; ++i) cholesky_[i * n + i] = std::sqrt(covariance_[i * n + i]);
     } else {
-      cholesky_ = cholesky_factor(covariance_, n);
+      covariance_ = cov;
+      auto factor = cholesky_factor(covariance_, n);
+      require(factor.has_value(), "a positive definite covariance");
+      cholesky_ = std::move(*factor);
     }
     separable_ = true;
     for (std::size_t i = 0; i < n; ++i)
@@ -188,29 +162,13 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
         if (i != j && covariance_[i * n + j] != 0.0) separable_ = false;
     base_scale_.resize(n);
     for (std::size_t i = 0; i < n; ++i) base_scale_[i] = std::sqrt(covariance_[i * n + i]);
-    if (!separable_) {
-      if (type_ == NoiseType::Multiplicative)
-        throw ConfigError("noise.covariance",
-                          "multiplicative noise needs a diagonal covariance (n values), got a full matrix");
-      if (n > kMaxFullCovarianceDims)
-        throw ConfigError("noise.covariance",
-                          "a full (non-diagonal) covariance is supported up to " +
-                              std::to_string(kMaxFullCovarianceDims) + " state dimensions, got " +
-                              dims_text + "; give a diagonal covariance (n values)");
-    }
-  } else if (distribution_ == Distribution::Uniform) {
-    if (config.half_width.size() != n)
-      throw ConfigError("noise.half_width", "got " + std::to_string(config.half_width.size()) +
-                                                " values, expected " + dims_text +
-                                                " (example: half_width: [0.5, 0.5])");
-    for (std::size_t i = 0; i < n; ++i)
-      if (!(std::isfinite(config.half_width[i]) && config.half_width[i] > 0))
-        throw ConfigError("noise.half_width", "value " + std::to_string(i) + " = " +
-                                                  number(config.half_width[i]) + ", expected a positive number");
+    require(separable_ || (type_ == NoiseType::Additive && n <= kMaxFullCovarianceDims),
+            "a full covariance only with additive noise and at most kMaxFullCovarianceDims dimensions");
+  } else {
+    require(config.half_width.size() == n, "one half-width per dimension");
+    for (std::size_t i = 0; i < n; ++i) require(config.half_width[i] > 0, "positive half-widths");
     base_scale_ = config.half_width;
     separable_ = true;
-  } else {
-    throw ConfigError("noise.distribution", "this distribution is not supported by the core yet");
   }
 
   // The largest scale per dimension over the grid bounds the window for every current state.
@@ -236,16 +194,11 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
       }
       break;
     case Truncation::FixedRegion: {
-      if (config.fixed_region.size() != n)
-        throw ConfigError("noise.fixed_region", "got " + std::to_string(config.fixed_region.size()) +
-                                                    " values, expected " + dims_text +
-                                                    " (example: fixed_region: [1.0, 1.0])");
+      require(config.fixed_region.size() == n, "one fixed_region half-width per dimension");
       double cut = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
         const double region = config.fixed_region[i];
-        if (!(std::isfinite(region) && region >= 0))
-          throw ConfigError("noise.fixed_region", "value " + std::to_string(i) + " = " + number(region) +
-                                                      ", expected a non-negative number");
+        require(std::isfinite(region) && region > 0, "positive fixed_region half-widths");
         set_half(i, std::floor(region / eta_[i] + 1e-9));
         // The window contains [mu - h*eta, mu + h*eta] (|mu - nearest point| <= eta/2).
         const double kept = double(window_half_cells_[i]) * eta_[i];
@@ -261,9 +214,7 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states)
     }
     case Truncation::CuttingProbability: {
       const double gamma = config.cutting_probability;
-      if (!(gamma > 0 && gamma < 1))
-        throw ConfigError("noise.cutting_probability",
-                          "got " + number(gamma) + ", expected a number in (0, 1) (example: 1.0e-3)");
+      require(gamma > 0 && gamma < 1, "a cutting probability in (0, 1)");
       if (distribution_ == Distribution::Normal) {
         // Union bound over dimensions: each may lose gamma/n, split over both tails.
         const double z = normal_upper_quantile(gamma / (2.0 * double(std::max<std::size_t>(n, 1))));

@@ -1,5 +1,7 @@
 #pragma once
 // Internal interface of the OpenCL engine (not installed; tests include it through src/core).
+// Its parts: opencl_device (devices), opencl_source (generated program), opencl_program_cache
+// (building it), opencl_layout (memory layout), opencl_run (buffers and launches).
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -37,17 +39,11 @@ std::string selected_device_label(const ComputeConfig& compute);
 /// One attempt of an engine run, and the label of the CPU device a fallback would use.
 using EngineAttempt = std::function<Policy(const SynthesisOptions&, SynthesisReport*)>;
 using DeviceLabel = std::function<std::string(const ComputeConfig&)>;
-/// SPEC section 7: a device that fails (DeviceError) is retried once on the CPU device, with a
-/// warning in report->log, unless the failing device is that CPU device or `cpu` was asked for.
+/// A device that fails (DeviceError) is retried once on the CPU device, with a Warning
+/// DeviceFallback note in report->notes, unless the failing device is that CPU device or `cpu`
+/// was asked for (the first attempt's notes are kept).
 /// synthesize() calls it with synthesize_opencl; tests call it with failing attempts.
 Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisReport* report,
                                     const EngineAttempt& attempt, const DeviceLabel& cpu_label);
-
-/// The OpenCL C source built for a problem: generated prelude + dynamics + engine.cl.
-std::string opencl_program_source(const Abstraction& abstraction, bool on_the_fly,
-                                  std::size_t group_size);
-
-/// Nominal multiply-adds of one separable contraction of the problem's window.
-double contraction_multiply_adds(const Abstraction& abstraction);
 
 }  // namespace amytiss::detail

@@ -1,5 +1,7 @@
 #include "amytiss/policy.hpp"
 
+#include "amytiss/format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,12 +10,6 @@
 
 namespace amytiss {
 namespace {
-
-std::string format_number(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.10g", value);
-  return buffer;
-}
 
 std::string format_state(const double* state, std::size_t length) {
   std::string text = "[";

@@ -83,7 +83,7 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
     report->phases.clear();
   }
   if (progress) {
-    Progress setup{"setup", 0, horizon, "reference", seconds_since(start), -1};
+    Progress setup{Phase::Setup, 0, horizon, "reference", seconds_since(start), -1};
     if (!progress(setup)) throw Cancelled();
   }
 
@@ -178,7 +178,7 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
     if (progress) {
       const unsigned done = horizon - step;
       const double elapsed = seconds_since(start);
-      Progress update{"synthesis", done, horizon, "reference", elapsed,
+      Progress update{Phase::Synthesis, done, horizon, "reference", elapsed,
                       elapsed / double(done) * double(horizon - done)};
       if (!progress(update)) throw Cancelled();
     }

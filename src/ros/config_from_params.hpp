@@ -1,6 +1,6 @@
 #pragma once
 // ROS parameters -> amytiss::Config. The synthesizer's private namespace holds the YAML schema of
-// SPEC section 3 (loaded with <rosparam command="load">) plus a few node keys (kNodeParameterKeys)
+// docs/configuration.md (loaded with <rosparam command="load">) plus a few node keys (kNodeParameterKeys)
 // that are not part of the configuration.
 #include <string>
 #include <vector>

@@ -63,7 +63,7 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::State
 
 amytiss_msgs::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
   amytiss_msgs::SynthesizeFeedback feedback;
-  feedback.phase = progress.phase;
+  feedback.phase = amytiss::to_string(progress.phase);
   feedback.percent = progress.percent();
   feedback.steps_done = progress.steps_done;
   feedback.steps_total = progress.steps_total;
@@ -76,7 +76,7 @@ std::string describe_progress(const amytiss::Progress& progress) {
   std::ostringstream text;
   text.setf(std::ios::fixed);
   text.precision(0);
-  text << progress.phase << " " << progress.percent() << "% (step " << progress.steps_done << "/"
+  text << amytiss::to_string(progress.phase) << " " << progress.percent() << "% (step " << progress.steps_done << "/"
        << progress.steps_total << ") on " << progress.device;
   text.precision(1);
   text << ", " << progress.elapsed_s << " s elapsed";

@@ -1,6 +1,7 @@
 #include "plant_model.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "amytiss/noise.hpp"
 
@@ -21,7 +22,10 @@ PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
     return;
   }
   // Full covariance: Cholesky factor L (Sigma = L L^T), so L z with z ~ N(0, I) has covariance Sigma.
-  noise_factor_ = amytiss::cholesky_factor(noise.covariance, n);
+  // The configuration passed validate(), which refuses a covariance without this factor.
+  auto factor = amytiss::cholesky_factor(noise.covariance, n);
+  if (!factor) throw std::logic_error("PlantModel: expected a validated configuration (positive definite covariance)");
+  noise_factor_ = std::move(*factor);
 }
 
 std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {

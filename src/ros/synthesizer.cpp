@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "amytiss/abstraction.hpp"
+#include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
 #include "config_from_params.hpp"
@@ -37,7 +38,7 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
                      [this](const amytiss_msgs::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
   status_publisher_ = public_handle_.advertise<amytiss_msgs::PolicyStatus>("status", 1, /*latch=*/true);
   update_status([](amytiss_msgs::PolicyStatus& status) {
-    status.phase = "idle";
+    status.phase = amytiss_msgs::PolicyStatus::PHASE_IDLE;
     status.remaining_s = -1;
     status.message = "synthesizer started";
   });
@@ -57,9 +58,9 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
 void SynthesizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& diagnostic) {
   std::lock_guard<std::mutex> lock(status_mutex_);
   using diagnostic_msgs::DiagnosticStatus;
-  const unsigned char level = status_.phase == "error"       ? DiagnosticStatus::ERROR
-                              : status_.phase == "cancelled" ? DiagnosticStatus::WARN
-                                                             : DiagnosticStatus::OK;
+  const unsigned char level = status_.phase == amytiss_msgs::PolicyStatus::PHASE_ERROR       ? DiagnosticStatus::ERROR
+                              : status_.phase == amytiss_msgs::PolicyStatus::PHASE_CANCELLED ? DiagnosticStatus::WARN
+                                                                                             : DiagnosticStatus::OK;
   diagnostic.summary(level, status_.phase + ": " + status_.message);
   diagnostic.add("policy ready", bool(status_.ready));
   diagnostic.add("synthesizing", bool(status_.synthesizing));
@@ -125,7 +126,7 @@ SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<am
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
     update_status([&](amytiss_msgs::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "error";
+      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
@@ -144,7 +145,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     outcome.message = std::string("bad policy_file parameter: ") + error.what();
     ROS_ERROR("%s", outcome.message.c_str());
     update_status([&](amytiss_msgs::PolicyStatus& status) {
-      status.phase = "error";
+      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
@@ -164,7 +165,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       status.horizon = policy.horizon;
       status.run_id = policy.run_id;
       status.generation += 1;
-      if (phase == "done") status.syntheses_run += 1;
+      if (phase == amytiss_msgs::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
     });
   };
 
@@ -176,7 +177,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name +
                         "' unchanged, hash " + hash + "); nothing to synthesize";
       ROS_INFO("%s", outcome.message.c_str());
-      announce(loaded.policy, "reused");
+      announce(loaded.policy, amytiss_msgs::PolicyStatus::PHASE_REUSED);
       return outcome;
     } catch (const amytiss::PolicyFileError& error) {
       ROS_WARN("not reusing %s: %s; computing it again", outcome.policy_file.c_str(), error.what());
@@ -188,7 +189,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
   update_status([&](amytiss_msgs::PolicyStatus& status) {
     status.synthesizing = true;
     status.percent = 0.0;
-    status.phase = "setup";
+    status.phase = amytiss_msgs::PolicyStatus::PHASE_SETUP;
     status.device = device;
     status.remaining_s = -1;
     status.message = "synthesizing '" + config.name + "' on " + device;
@@ -204,7 +205,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       update_status([&](amytiss_msgs::PolicyStatus& status) {
         status.synthesizing = true;
         status.percent = progress.percent();
-        status.phase = progress.phase;
+        status.phase = amytiss::to_string(progress.phase);
         status.device = progress.device;
         status.remaining_s = progress.remaining_s;
         status.message = text;
@@ -214,12 +215,11 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     };
     amytiss::SynthesisReport report;
     const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
-    for (const auto& note : report.log) {
-      // Device fallbacks are warnings (SPEC section 7); the other notes (storage, memory) are facts.
-      if (note.find("fall") != std::string::npos || note.find("no OpenCL") != std::string::npos)
-        ROS_WARN("%s", note.c_str());
+    for (const auto& note : report.notes) {
+      if (note.severity == amytiss::NoteSeverity::Warning)
+        ROS_WARN("%s", note.text.c_str());
       else
-        ROS_INFO("%s", note.c_str());
+        ROS_INFO("%s", note.text.c_str());
     }
     if (cancelled()) throw amytiss::Cancelled();
     std::filesystem::create_directories(std::filesystem::path(outcome.policy_file).parent_path());
@@ -235,13 +235,13 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     outcome.success = true;
     outcome.message = text;
     ROS_INFO("%s", text);
-    announce(policy, "done");
+    announce(policy, amytiss_msgs::PolicyStatus::PHASE_DONE);
   } catch (const amytiss::Cancelled&) {
     outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
     ROS_WARN("%s", outcome.message.c_str());
     update_status([&](amytiss_msgs::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "cancelled";
+      status.phase = amytiss_msgs::PolicyStatus::PHASE_CANCELLED;
       status.remaining_s = -1;
       status.message = outcome.message;
     });
@@ -250,7 +250,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
     update_status([&](amytiss_msgs::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = "error";
+      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
       status.remaining_s = -1;
       status.message = outcome.message;
     });

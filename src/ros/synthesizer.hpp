@@ -7,7 +7,7 @@
 //   topic   status (amytiss_msgs/PolicyStatus, latched): progress, errors, and each new policy;
 //           republished every ~heartbeat_period_s as a heartbeat.
 //   topic   /diagnostics (diagnostic_updater): synthesis state, device, the ready policy.
-// Private parameters: the configuration schema (SPEC section 3), plus
+// Private parameters: the configuration schema (docs/configuration.md), plus
 //   ~policy_file (string, default $ROS_HOME/amytiss/<name>.h5, ROS_HOME defaults to ~/.ros),
 //   ~device (string, overrides compute.device when not empty: auto | cpu | gpu | reference),
 //   ~synthesize_on_start (bool, default true),

@@ -1,4 +1,4 @@
-// Configuration: the YAML schema, every bad input of SPEC section 7, the canonical text and the hash.
+// Configuration: the YAML schema, every bad input that validate() refuses (docs/configuration.md), the canonical text and the hash.
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -8,6 +8,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
+#include "test_support.hpp"
 
 namespace amytiss {
 namespace {
@@ -497,6 +498,17 @@ TEST(Config, ExamplesLoadWithThePapersSizes) {
   const Config robot = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/robot_safety.yaml");
   ASSERT_TRUE(robot.disturbances.has_value());
   EXPECT_EQ(points(*robot.disturbances), 11u);
+}
+
+// The tests' helper builds configurations that pass the one gate, like any user input must.
+TEST(Config, TestSupportBuildsValidConfigs) {
+  using namespace test_support;
+  EXPECT_NO_THROW(make_config(grid_spec({0, 0}, {1, 1}, {0.5, 0.5}), grid_spec({-1}, {1}, {1}), std::nullopt,
+                              normal_noise({0.1, 0.1}), safety_spec(2), "helper")
+                      .validate());
+  EXPECT_NO_THROW(make_config(grid_spec({0}, {4}, {1}), std::nullopt, grid_spec({0}, {1}, {1}),
+                              uniform_noise({0.5}), reach_avoid_spec(3, box({3}, {4}), box({0}, {1})), "helper")
+                      .validate());
 }
 
 }  // namespace

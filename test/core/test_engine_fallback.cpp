@@ -1,4 +1,4 @@
-// SPEC section 7: a failing device falls back to the CPU device with a warning.
+// A failing device falls back to the CPU device with a warning note (docs/engine.md).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -22,7 +22,7 @@ struct ScriptedEngine {
     requested.push_back(options.compute.device);
     const bool on_cpu = options.compute.device == DeviceKind::Cpu;
     report->device = on_cpu ? kCpuLabel : kGpuLabel;
-    report->log.push_back("attempt on " + report->device);
+    report->notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "attempt on " + report->device});
     if (!on_cpu || cpu_fails) throw DeviceError("clEnqueueNDRangeKernel failed: CL_OUT_OF_RESOURCES");
     Policy policy;
     policy.computed_by = report->device;
@@ -52,10 +52,11 @@ TEST(EngineFallback, FailingGpuIsRetriedOnTheCpuDeviceWithAWarning) {
   EXPECT_EQ(engine.requested[1], DeviceKind::Cpu);
   EXPECT_EQ(report.device, kCpuLabel);
   bool warned = false;
-  for (const auto& line : report.log)
-    warned = warned || (line.rfind("warning: " + kGpuLabel + " failed (", 0) == 0 &&
-                        line.find("CL_OUT_OF_RESOURCES") != std::string::npos &&
-                        line.find("falling back to the CPU device " + kCpuLabel) != std::string::npos);
+  for (const auto& note : report.notes)
+    warned = warned || (note.severity == NoteSeverity::Warning && note.kind == NoteKind::DeviceFallback &&
+                        note.text.rfind(kGpuLabel + " failed (", 0) == 0 &&
+                        note.text.find("CL_OUT_OF_RESOURCES") != std::string::npos &&
+                        note.text.find("falling back to the CPU device " + kCpuLabel) != std::string::npos);
   EXPECT_TRUE(warned) << "no fallback warning in the report log";
 }
 

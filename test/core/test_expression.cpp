@@ -193,8 +193,10 @@ TEST(Expression, ToCText) {
   EXPECT_EQ(c("abs(x1) + min(x0, 1) + max(w0, 2)"), "(fabs(x[1]) + fmin(x[0], 1.0) + fmax(w[0], 2.0))");
   EXPECT_EQ(c("x0^2"), "pow(x[0], 2.0)");
   EXPECT_EQ(c("if(x0 < 1, 2, 3)"), "((((double)(x[0] < 1.0)) != 0.0) ? 2.0 : 3.0)");
-  EXPECT_EQ(c("0.1"), "0.10000000000000001");
-  EXPECT_EQ(c("1e300"), "1.0000000000000001e+300");
+  // The shortest text that reads back to the same double.
+  EXPECT_EQ(c("0.1"), "0.1");
+  EXPECT_EQ(c("1e300"), "1e+300");
+  EXPECT_EQ(c("0.30000000000000004"), "0.30000000000000004");
   EXPECT_EQ(c("-x0"), "(-x[0])");
 }
 

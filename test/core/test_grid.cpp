@@ -137,11 +137,11 @@ TEST(Grid, PointInClosedBox) {
 }
 
 TEST(Grid, RejectsBadSpecs) {
-  EXPECT_THROW(Grid(grid_spec({0}, {1}, {0})), ConfigError);
-  EXPECT_THROW(Grid(grid_spec({0}, {1}, {-0.5})), ConfigError);
-  EXPECT_THROW(Grid(grid_spec({1}, {0}, {0.5})), ConfigError);
-  EXPECT_THROW(Grid(grid_spec({0, 0}, {1}, {0.5})), ConfigError);
-  EXPECT_THROW(Grid(grid_spec({0}, {1e300}, {1e-300})), ConfigError);
+  EXPECT_THROW(Grid(grid_spec({0}, {1}, {0})), std::logic_error);
+  EXPECT_THROW(Grid(grid_spec({0}, {1}, {-0.5})), std::logic_error);
+  EXPECT_THROW(Grid(grid_spec({1}, {0}, {0.5})), std::logic_error);
+  EXPECT_THROW(Grid(grid_spec({0, 0}, {1}, {0.5})), std::logic_error);
+  EXPECT_THROW(Grid(grid_spec({0}, {1e300}, {1e-300})), std::logic_error);
 }
 
 }  // namespace

@@ -176,11 +176,12 @@ TEST(Models, MakeDynamicsErrors) {
   Config config = config_with("vehicle3d", 3, 2);
   config.model = "tesla";
   try {
-    make_dynamics(config);
+    config.validate();
     FAIL();
   } catch (const ConfigError& error) {
     EXPECT_EQ(error.key(), "model");
   }
+  EXPECT_THROW(make_dynamics(config), std::logic_error);  // validate() is the gate
   config = config_with(R"(["x0", "x1"])", 2, 1);
   config.dynamics[1] = "x1 +";
   try {

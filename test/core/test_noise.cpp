@@ -18,7 +18,7 @@ using test_support::uniform_noise;
 
 constexpr double kQuadratureTolerance = 1e-12;     // absolute, 1-d cell masses vs quadrature
 constexpr double kTailRelativeTolerance = 1e-9;    // relative, masses far in the tails
-constexpr double kRowSumSlack = 1e-6;              // SPEC: rows sum to at most 1 + 1e-6
+constexpr double kRowSumSlack = 1e-6;              // rows sum to at most 1 + 1e-6 (docs/engine.md, precision)
 constexpr double kRoundingSlack = 1e-12;
 constexpr double kQuantileRelativeTolerance = 1e-12;
 
@@ -253,21 +253,37 @@ TEST(MultiplicativeNoise, ScalesWithStateAndPointMassAtZero) {
   // (A full matrix with multiplicative noise is refused: NoiseConfigErrors.)
 }
 
+// Config::validate() (the gate for every input) on a safety problem over `grid` with this noise.
+void validate_noise(const NoiseConfig& noise, const Grid& grid) {
+  GridSpec states;
+  states.lb = grid.lb();
+  states.eta = grid.eta();
+  for (std::size_t i = 0; i < grid.dims(); ++i) states.ub.push_back(grid.coordinate(i, grid.count(i) - 1));
+  test_support::make_config(states, std::nullopt, std::nullopt, noise, test_support::safety_spec(1)).validate();
+}
+
+TEST(NoiseConfigErrors, ConstructorAssertsAValidatedConfig) {
+  const Grid grid(grid_spec({0, 0}, {1, 1}, {0.5, 0.5}));
+  EXPECT_THROW(NoiseModel(normal_noise({1.0}), grid), std::logic_error);
+  EXPECT_THROW(NoiseModel(normal_noise({1.0, 2.0, 2.0, 1.0}), grid), std::logic_error);
+  EXPECT_THROW(NoiseModel(uniform_noise({1.0}), grid), std::logic_error);
+}
+
 TEST(NoiseConfigErrors, RejectsBadCovariance) {
   const Grid grid(grid_spec({0, 0}, {1, 1}, {0.5, 0.5}));
-  EXPECT_THROW(NoiseModel(normal_noise({1.0}), grid), ConfigError);                      // wrong size
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 0.5, 0.4, 1.0}), grid), ConfigError);       // not symmetric
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 2.0, 2.0, 1.0}), grid), ConfigError);       // not positive definite
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, -1.0}), grid), ConfigError);                // negative variance
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 0.0, 0.0, 0.0}), grid), ConfigError);       // full: not SPD
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 1.0}, Truncation::CuttingProbability, 1.5), grid), ConfigError);
-  EXPECT_THROW(NoiseModel(normal_noise({1.0, 1.0}, Truncation::FixedRegion, 1e-3, {1.0}), grid), ConfigError);
-  EXPECT_THROW(NoiseModel(uniform_noise({1.0}), grid), ConfigError);
+  EXPECT_THROW(validate_noise(normal_noise({1.0}), grid), ConfigError);                      // wrong size
+  EXPECT_THROW(validate_noise(normal_noise({1.0, 0.5, 0.4, 1.0}), grid), ConfigError);       // not symmetric
+  EXPECT_THROW(validate_noise(normal_noise({1.0, 2.0, 2.0, 1.0}), grid), ConfigError);       // not positive definite
+  EXPECT_THROW(validate_noise(normal_noise({1.0, -1.0}), grid), ConfigError);                // negative variance
+  EXPECT_THROW(validate_noise(normal_noise({1.0, 0.0, 0.0, 0.0}), grid), ConfigError);       // full: not SPD
+  EXPECT_THROW(validate_noise(normal_noise({1.0, 1.0}, Truncation::CuttingProbability, 1.5), grid), ConfigError);
+  EXPECT_THROW(validate_noise(normal_noise({1.0, 1.0}, Truncation::FixedRegion, 1e-3, {1.0}), grid), ConfigError);
+  EXPECT_THROW(validate_noise(uniform_noise({1.0}), grid), ConfigError);
   NoiseConfig multiplicative_full = normal_noise({1.0, 0.5, 0.5, 1.0});
   multiplicative_full.type = NoiseType::Multiplicative;
-  EXPECT_THROW(NoiseModel(multiplicative_full, grid), ConfigError);
+  EXPECT_THROW(validate_noise(multiplicative_full, grid), ConfigError);
   try {
-    NoiseModel(normal_noise({1.0, 2.0, 2.0, 1.0}), grid);
+    validate_noise(normal_noise({1.0, 2.0, 2.0, 1.0}), grid);
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& error) {
     EXPECT_EQ(error.key(), "noise.covariance");
@@ -429,13 +445,13 @@ TEST(ZeroVariance, DiagonalZeroIsAPointMassWithAOneCellWindow) {
 TEST(ZeroVariance, NegativeVarianceAndSingularFullMatrixRefused) {
   const Grid grid(grid_spec({0, 0}, {1, 1}, {0.5, 0.5}));
   try {
-    NoiseModel(normal_noise({0.0, -1e-9}), grid);
+    validate_noise(normal_noise({0.0, -1e-9}), grid);
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& error) {
-    EXPECT_EQ(error.key(), "noise.covariance");
+    EXPECT_EQ(error.key(), "noise.covariance[1]");
     EXPECT_NE(std::string(error.what()).find(">= 0"), std::string::npos) << error.what();
   }
-  EXPECT_THROW(NoiseModel(normal_noise({0.25, 0.0, 0.0, 0.0}), grid), ConfigError);
+  EXPECT_THROW(validate_noise(normal_noise({0.25, 0.0, 0.0, 0.0}), grid), ConfigError);
   EXPECT_NO_THROW(NoiseModel(normal_noise({0.0, 0.0}), grid));
 }
 
@@ -443,7 +459,7 @@ TEST(FullCovariance, TooManyDimensionsRefused) {
   const Grid grid(grid_spec(std::vector<double>(5, 0), std::vector<double>(5, 1), std::vector<double>(5, 1)));
   std::vector<double> covariance(25, 0.1);
   for (int i = 0; i < 5; ++i) covariance[i * 6] = 1.0;
-  EXPECT_THROW(NoiseModel(normal_noise(covariance), grid), ConfigError);
+  EXPECT_THROW(validate_noise(normal_noise(covariance), grid), ConfigError);
 }
 
 }  // namespace

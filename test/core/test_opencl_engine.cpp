@@ -18,6 +18,7 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
 #include "opencl_engine.hpp"
+#include "opencl_source.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -369,13 +370,13 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     EXPECT_EQ(other.values, stored.values) << variant.name;
     EXPECT_EQ(other.input_index, stored.input_index) << variant.name;
     const bool group = variant.engine.variant == SweepVariant::GroupPerState;
-    const bool logged = std::any_of(report.log.begin(), report.log.end(), [&](const std::string& line) {
-      return line.find(group ? "work-group" : "work-item") != std::string::npos;
+    const bool logged = std::any_of(report.notes.begin(), report.notes.end(), [&](const EngineNote& note) {
+      return note.kind == NoteKind::Sweep && note.text.find(group ? "work-group" : "work-item") != std::string::npos;
     });
     EXPECT_TRUE(logged) << variant.name << ": the sweep variant that ran is logged";
     if (variant.engine.max_states_per_chunk) {
-      EXPECT_TRUE(std::any_of(report.log.begin(), report.log.end(),
-                              [](const std::string& line) { return line.find("chunks") != std::string::npos; }))
+      EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(),
+                              [](const EngineNote& note) { return note.kind == NoteKind::Chunking; }))
           << variant.name;
     }
   }
@@ -415,8 +416,8 @@ TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   EXPECT_FALSE(report.device.empty());
   EXPECT_EQ(policy.computed_by, report.device);
   ASSERT_EQ(seen.size(), 5u);  // setup, construction, 3 steps
-  EXPECT_EQ(seen.front().phase, "setup");
-  EXPECT_EQ(seen[1].phase, "construction");
+  EXPECT_EQ(seen.front().phase, Phase::Setup);
+  EXPECT_EQ(seen[1].phase, Phase::Construction);
   EXPECT_EQ(seen.back().steps_done, 3u);
   EXPECT_DOUBLE_EQ(seen.back().percent(), 100.0);
 }
@@ -462,8 +463,9 @@ TEST(OpenClEngine, GpuRequestWithoutGpuFallsBackWithWarning) {
   options.compute.device = DeviceKind::Gpu;
   SynthesisReport report;
   synthesize(a, options, &report);
-  EXPECT_TRUE(std::any_of(report.log.begin(), report.log.end(), [](const std::string& line) {
-    return line.find("warning") != std::string::npos && line.find("no OpenCL GPU") != std::string::npos;
+  EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(), [](const EngineNote& note) {
+    return note.severity == NoteSeverity::Warning && note.kind == NoteKind::DeviceFallback &&
+           note.text.find("no OpenCL GPU") != std::string::npos;
   }));
 }
 
@@ -503,8 +505,8 @@ TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
   OpenClEngineOptions engine;
   engine.kernel_cache_dir = cache;
   auto logged = [](const SynthesisReport& report, const std::string& text) {
-    return std::any_of(report.log.begin(), report.log.end(),
-                       [&](const std::string& line) { return line.find(text) != std::string::npos; });
+    return std::any_of(report.notes.begin(), report.notes.end(),
+                       [&](const EngineNote& note) { return note.text.find(text) != std::string::npos; });
   };
   SynthesisReport first_report, second_report, third_report, uncached_report;
   const Policy first = detail::synthesize_opencl(a, cpu_options(), &first_report, engine);
@@ -532,7 +534,7 @@ TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
 }
 
 TEST(OpenClEngine, RobotReachAvoidFullGridAgreesWithReference) {
-  // SPEC section 5's grid: 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
+  // The robot reach-avoid example's grid (config/robot_reach_avoid.yaml): 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
   // 16 only to keep the serial reference under ~10 s here; the T_d = 16 comparison is recorded in
   // docs/engine.md (max |dV| 2.2e-7).
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(0.5, 0.1, 6));

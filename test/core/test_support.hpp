@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
+#include "amytiss/format.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/model.hpp"
 
@@ -112,18 +113,19 @@ inline SpecConfig reach_avoid_spec(unsigned horizon, Box target, std::optional<B
   return spec;
 }
 
-/// A Config for from_parts. `description` goes into config.dynamics[0] only so that different
-/// test problems get different config hashes (it is never parsed).
+/// A valid Config for from_parts (it passes Config::validate() when the grids and the spec do).
+/// `description` is its name, so that different test problems get different config hashes; its
+/// dynamics is the identity x_i (from_parts runs the dynamics it is given).
 inline Config make_config(GridSpec states, std::optional<GridSpec> inputs, std::optional<GridSpec> disturbances,
                           NoiseConfig noise, SpecConfig spec, const std::string& description = "test") {
   Config config;
-  config.name = "test";
+  config.name = description;
   config.states = std::move(states);
   config.inputs = std::move(inputs);
   config.disturbances = std::move(disturbances);
   config.noise = std::move(noise);
   config.spec = std::move(spec);
-  config.dynamics = {description};
+  for (std::size_t i = 0; i < config.states.lb.size(); ++i) config.dynamics.push_back("x" + std::to_string(i));
   config.compute.device = DeviceKind::Reference;
   return config;
 }
@@ -151,11 +153,7 @@ inline Abstraction random_affine_abstraction(std::uint64_t seed, std::size_t sta
   for (auto& value : b) value = 2.0 * coefficient(generator);
   for (auto& value : c) value = coefficient(generator);
   for (auto& value : offset) value = 0.25 * coefficient(generator);
-  auto print = [](double value) {
-    char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.17g", value);
-    return std::string(buffer);
-  };
+  auto print = [](double value) { return format_number(value); };
   std::string body;
   for (std::size_t i = 0; i < state_dims; ++i) {
     body += "post[" + std::to_string(i) + "] = " + print(offset[i]);

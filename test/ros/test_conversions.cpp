@@ -242,7 +242,7 @@ TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerializa
 
 TEST(ProgressConversions, FeedbackCarriesEveryField) {
   amytiss::Progress progress;
-  progress.phase = "synthesis";
+  progress.phase = amytiss::Phase::Synthesis;
   progress.steps_done = 7;
   progress.steps_total = 16;
   progress.device = "reference";
@@ -329,4 +329,20 @@ TEST(Outcomes, ClassifyByCellRole) {
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
+}
+
+// The engine's phase names are the message constants, in PolicyStatus and in the action feedback.
+TEST(ProgressConversions, PhaseNamesAreTheMessageConstants) {
+  const std::pair<amytiss::Phase, std::string> status_phases[] = {
+      {amytiss::Phase::Setup, amytiss_msgs::PolicyStatus::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss_msgs::PolicyStatus::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss_msgs::PolicyStatus::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss_msgs::PolicyStatus::PHASE_DONE}};
+  for (const auto& [phase, name] : status_phases) EXPECT_EQ(amytiss::to_string(phase), name);
+  const std::pair<amytiss::Phase, std::string> feedback_phases[] = {
+      {amytiss::Phase::Setup, amytiss_msgs::SynthesizeFeedback::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss_msgs::SynthesizeFeedback::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss_msgs::SynthesizeFeedback::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss_msgs::SynthesizeFeedback::PHASE_DONE}};
+  for (const auto& [phase, name] : feedback_phases) EXPECT_EQ(amytiss::to_string(phase), name);
 }

@@ -1,17 +1,21 @@
 // amytiss OpenCL engine: MDP construction (stored transitions), synthesis sweep (stored and
 // on-the-fly). One algorithm for every device; the host prepends a generated prelude that
-// defines the problem as compile-time constants (see opencl_program.cpp) and the system's
-// amytiss_dynamics(), and appends nothing.
+// defines the problem as compile-time constants, the contraction functions and the system's
+// amytiss_dynamics() (see opencl_source.cpp), and appends nothing.
 //
-// Prelude contract (all numbers printed by the host with 17 significant digits):
+// Prelude contract (all numbers printed by the host so that they read back exactly):
 //   STATE_DIMS, INPUT_DIMS, DIST_DIMS         dimensions (INPUT/DIST may be 0)
 //   N_STATES, N_INPUTS, N_DISTS               grid sizes (1 for a zero-dimensional grid)
-//   MASS_RECORD                               sum_i (2 h_i + 1): floats of one transition record
-//   BOUNDS_CAPACITY                           max_i (2 h_i + 2) rounded up to a multiple of 8
+//   MASS_RECORD                               sum_i WIDTH[i]: floats of one transition record
+//                                             (WIDTH[i] = n_i for a whole-grid dimension, else
+//                                             2 min(h_i, n_i - 1) + 1; Layout in opencl_layout.hpp)
+//   BOUNDS_CAPACITY                           (max_i WIDTH[i] + 1) rounded up to a multiple of 8
 //   MULTIPLICATIVE (0/1), UNIFORM (0/1: 0 = normal), TRUNCATION_NONE (0/1), ON_THE_FLY (0/1)
 //   GROUP_SIZE                                work-items per group of synthesize_group
+//   ROLE_FREE, ROLE_FIXED_ZERO, ROLE_FIXED_ONE the cell-role codes of the roles buffer (CellRole)
 //   __constant arrays (length max(1, dims)): STATE_LB, STATE_ETA (double), STATE_COUNT,
-//   HALF_CELLS, WIDTH, MASS_OFFSET, PADDED_STRIDE (int); KEEP_HALF (long: NoiseModel's h); INPUT_LB, INPUT_ETA, INPUT_COUNT;
+//   HALF_CELLS, WHOLE_DIM, WIDTH, MASS_OFFSET, PADDED_STRIDE (int); KEEP_HALF (long: NoiseModel's h);
+//   INPUT_LB, INPUT_ETA, INPUT_COUNT;
 //   DIST_LB, DIST_ETA, DIST_COUNT; NOISE_SCALE (double, the additive scale per dimension).
 //   double contract_global(__global const double* v, __global const float* m) and
 //   double contract_private(__global const double* v, const float* m): the separable contraction
@@ -19,8 +23,8 @@
 //     generated with the window widths as literal trip counts (same text, two address spaces:
 //     stored records are read in place, on-the-fly records from private memory).
 //
-// Value layout: V (double) lives in a padded array, each dimension extended by h_i zero cells on
-// both sides (plus 4 zero cells at the end for the contraction's vector over-read), so a window
+// Value layout: V (double) lives in a padded array, each dimension extended by HALF_CELLS[i] zero
+// cells on both sides (plus 4 zero cells at the end for the contraction's vector over-read), so a window
 // never needs clipping in the sweep: a transition record is the padded flat
 // offset of its window's first cell plus its per-dimension masses (zero where the window leaves
 // the grid or the truncation region).
@@ -274,8 +278,8 @@ double probability_from_sum(double value) { return fmin(value, 1.0); }
 bool handle_fixed(uint state, uint offset, __global const uchar* roles, __global double* v_next,
                   __global uint* best_input) {
   const uchar role = roles[state];
-  if (role == 0) return true;
-  v_next[offset] = role == 2 ? 1.0 : 0.0;
+  if (role == ROLE_FREE) return true;
+  v_next[offset] = role == ROLE_FIXED_ONE ? 1.0 : 0.0;
   best_input[state] = 0;
   return false;
 }
@@ -311,7 +315,7 @@ void synthesize_group(__global const double* v, __global double* v_next,
   if (local_state >= state_count) return;  // uniform over the group
   const uint state = state_begin + local_state;
   const uint offset = padded_offset(state);
-  if (roles[state] != 0) {
+  if (roles[state] != ROLE_FREE) {
     if (lane == 0) handle_fixed(state, offset, roles, v_next, best_input);
     return;  // uniform over the group
   }

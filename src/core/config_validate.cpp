@@ -1,0 +1,311 @@
+// Config::validate(): the one place that judges a configuration (docs/configuration.md). Errors
+// name the key, the value received and an example of a valid value.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+#include "amytiss/config.hpp"
+#include "amytiss/expression.hpp"
+#include "amytiss/model.hpp"
+#include "amytiss/noise.hpp"
+#include "config_messages.hpp"
+
+namespace amytiss {
+namespace {
+
+using detail::fail;
+using detail::format_list;
+using detail::indexed;
+using detail::join;
+
+constexpr std::uint64_t kMaxGridPoints = 4294967295ull;          // 2^32 - 1: indices are uint32
+constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
+// Covariance entries (r, k) and (k, r) may differ by this much relative to max(1, |entry|).
+constexpr double kSymmetryTolerance = 1e-12;
+
+const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
+
+std::uint64_t points_of_dimension(double lb, double ub, double eta) {
+  return static_cast<std::uint64_t>(std::floor((ub - lb) / eta + 0.5)) + 1;
+}
+
+void check_finite_list(const std::vector<double>& values, const std::string& key, const std::string& example) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i])) fail(indexed(key, i), format_number(values[i]), "a finite number", example);
+}
+
+/// Checks a grid and returns its number of points (saturated at UINT64_MAX).
+double check_grid(const GridSpec& grid, const std::string& key, const std::string& omit_hint) {
+  const std::string example = key.substr(key.rfind('.') + 1) + ": " + kGridExample;
+  if (grid.lb.empty())
+    throw ConfigError(key + ".lb", "got [], expected at least one value" + omit_hint + " (example: " + example + ")");
+  check_finite_list(grid.lb, key + ".lb", example);
+  check_finite_list(grid.ub, key + ".ub", example);
+  check_finite_list(grid.eta, key + ".eta", example);
+  if (grid.ub.size() != grid.lb.size())
+    fail(key + ".ub", std::to_string(grid.ub.size()) + " values", std::to_string(grid.lb.size()) +
+         " values, as many as " + key + ".lb", example);
+  if (grid.eta.size() != grid.lb.size())
+    fail(key + ".eta", std::to_string(grid.eta.size()) + " values", std::to_string(grid.lb.size()) +
+         " values, as many as " + key + ".lb", example);
+  double points = 1;
+  for (std::size_t i = 0; i < grid.lb.size(); ++i) {
+    if (grid.eta[i] <= 0)
+      fail(indexed(key + ".eta", i), format_number(grid.eta[i]), "a number > 0", "eta: [0.5, 0.5]");
+    if (grid.lb[i] > grid.ub[i])
+      fail(indexed(key + ".ub", i), format_number(grid.ub[i]),
+           "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(grid.lb[i]), example);
+    points *= std::floor((grid.ub[i] - grid.lb[i]) / grid.eta[i] + 0.5) + 1;
+  }
+  if (points > double(kMaxGridPoints))
+    throw ConfigError(key, "grid too large: " + format_number(points) +
+                               " points, at most 4294967295 (2^32 - 1) are supported; use a larger eta");
+  return points;
+}
+
+// Grid indices first..last of dimension i that a (validated) box contains, by the membership rule
+// of Grid::point_in_box (closed box, 1e-9*eta tolerance).
+std::pair<double, double> box_index_range(const Box& box, const GridSpec& states, std::size_t i) {
+  const double eta = states.eta[i];
+  const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
+  const double first = std::max(0.0, std::ceil((box.lb[i] - states.lb[i]) / eta - 1e-9));
+  const double last = std::min(count - 1, std::floor((box.ub[i] - states.lb[i]) / eta + 1e-9));
+  return {first, last};
+}
+
+// A cell in both boxes would silently become avoid (avoid wins in the roles): refuse it.
+void check_target_avoid_disjoint(const Box& target, const Box& avoid, const GridSpec& states) {
+  std::vector<double> shared;
+  for (std::size_t i = 0; i < states.lb.size(); ++i) {
+    const auto target_range = box_index_range(target, states, i);
+    const auto avoid_range = box_index_range(avoid, states, i);
+    const double first = std::max(target_range.first, avoid_range.first);
+    const double last = std::min(target_range.second, avoid_range.second);
+    if (first > last) return;
+    shared.push_back(states.lb[i] + first * states.eta[i]);
+  }
+  throw ConfigError("spec.avoid", "the avoid box " + format_list(avoid.lb) + " .. " + format_list(avoid.ub) +
+                                      " and the target box " + format_list(target.lb) + " .. " +
+                                      format_list(target.ub) + " share grid points, for example " +
+                                      format_list(shared) +
+                                      "; expected boxes without a common grid point (shrink one of them)");
+}
+
+void check_box(const Box& box, const std::string& key, const GridSpec& states) {
+  const std::string name = key.substr(key.rfind('.') + 1);
+  const std::string example = name + ": {lb: [5, 5], ub: [7, 7]}";
+  const std::size_t n = states.lb.size();
+  if (box.lb.size() != n)
+    fail(key + ".lb", std::to_string(box.lb.size()) + " values", std::to_string(n) + " values (one per state)", example);
+  if (box.ub.size() != n)
+    fail(key + ".ub", std::to_string(box.ub.size()) + " values", std::to_string(n) + " values (one per state)", example);
+  check_finite_list(box.lb, key + ".lb", example);
+  check_finite_list(box.ub, key + ".ub", example);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (box.lb[i] > box.ub[i])
+      fail(indexed(key + ".ub", i), format_number(box.ub[i]),
+           "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(box.lb[i]), example);
+    // Same membership rule as Grid::point_in_box: closed box with a 1e-9*eta tolerance.
+    const double eta = states.eta[i];
+    const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
+    const auto [first, last] = box_index_range(box, states, i);
+    if (first > last)
+      throw ConfigError(key, "the box " + format_list(box.lb) + " .. " + format_list(box.ub) +
+                                 " contains no representative point of the state grid in dimension " +
+                                 std::to_string(i) + " (points " + format_number(states.lb[i]) + ", " +
+                                 format_number(states.lb[i] + eta) + ", ..., " +
+                                 format_number(states.lb[i] + (count - 1) * eta) +
+                                 "); widen the box or refine states.eta (example: " + example + ")");
+  }
+}
+
+bool is_identifier(const std::string& name) {
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+bool looks_like_variable(const std::string& name) {
+  if (name.size() < 2 || std::string("xuw").find(name[0]) == std::string::npos) return false;
+  for (std::size_t i = 1; i < name.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
+  return true;
+}
+
+const std::vector<std::string> kFunctionNames = {"sin", "cos",  "tan", "asin", "acos", "atan",  "atan2", "exp", "log",
+                                                 "sqrt", "pow", "abs", "min", "max",  "floor", "ceil",  "if"};
+
+void check_noise(const NoiseConfig& noise, std::size_t n) {
+  const std::string n_text = std::to_string(n);
+  if (noise.distribution == Distribution::Normal) {
+    const std::string example = n == 2 ? "covariance: [0.75, 0.75]" : "covariance: [" + n_text + " variances]";
+    if (!noise.half_width.empty())
+      throw ConfigError("noise.half_width", "given for distribution normal; it is only used by distribution uniform");
+    const auto& c = noise.covariance;
+    if (c.size() != n && c.size() != n * n)
+      fail("noise.covariance", std::to_string(c.size()) + " values",
+           n_text + " values (diagonal) or " + std::to_string(n * n) + " values (full matrix, row-major)", example);
+    check_finite_list(c, "noise.covariance", example);
+    if (c.size() == n) {
+      for (std::size_t i = 0; i < n; ++i)
+        if (c[i] < 0)
+          fail(indexed("noise.covariance", i), format_number(c[i]),
+               "a variance >= 0 (0: no noise in that dimension)", example);
+    } else {
+      if (noise.type == NoiseType::Multiplicative)
+        throw ConfigError("noise.covariance",
+                          "a full covariance matrix with multiplicative noise is not supported; give the " + n_text +
+                              " diagonal variances (example: " + example + ")");
+      bool diagonal = true;
+      for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t k = 0; k < n; ++k)
+          if (r != k && c[r * n + k] != 0.0) diagonal = false;
+      if (!diagonal && n > NoiseModel::kMaxFullCovarianceDims)
+        throw ConfigError("noise.covariance",
+                          "a full (non-diagonal) covariance is supported up to " +
+                              std::to_string(NoiseModel::kMaxFullCovarianceDims) + " state dimensions, got " + n_text +
+                              " (the quadrature cost grows like points^(n-1)); give the " + n_text +
+                              " diagonal variances (example: " + example + ")");
+      const auto entry = [&](std::size_t r, std::size_t k) { return c[r * n + k]; };
+      for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t k = r + 1; k < n; ++k)
+          if (std::fabs(entry(r, k) - entry(k, r)) >
+              kSymmetryTolerance * std::max(1.0, std::max(std::fabs(entry(r, k)), std::fabs(entry(k, r)))))
+            throw ConfigError("noise.covariance",
+                              "got a matrix that is not symmetric: entry (" + std::to_string(r) + "," +
+                                  std::to_string(k) + ") = " + format_number(entry(r, k)) + " but (" +
+                                  std::to_string(k) + "," + std::to_string(r) + ") = " + format_number(entry(k, r)) +
+                                  "; expected a symmetric positive definite " + n_text + "x" + n_text +
+                                  " matrix, row-major");
+      // The same factorization the noise model computes its masses with.
+      if (!cholesky_factor(c, n))
+        throw ConfigError("noise.covariance", "got " + format_list(c) +
+                                                  ", which is not positive definite (Cholesky failed); expected a "
+                                                  "symmetric positive definite " + n_text + "x" + n_text +
+                                                  " matrix, row-major, or " + n_text + " positive variances");
+    }
+  } else {
+    const std::string example = "half_width: [" + n_text + " positive numbers]";
+    if (!noise.covariance.empty())
+      throw ConfigError("noise.covariance",
+                        "given for distribution uniform; use noise.half_width (example: " + example + ")");
+    if (noise.half_width.size() != n)
+      fail("noise.half_width", std::to_string(noise.half_width.size()) + " values", n_text + " values (one per state)",
+           example);
+    check_finite_list(noise.half_width, "noise.half_width", example);
+    for (std::size_t i = 0; i < n; ++i)
+      if (noise.half_width[i] <= 0)
+        fail(indexed("noise.half_width", i), format_number(noise.half_width[i]), "a number > 0", example);
+  }
+  if (!(noise.cutting_probability > 0 && noise.cutting_probability < 1))
+    fail("noise.cutting_probability", format_number(noise.cutting_probability), "a probability in (0, 1)",
+         "cutting_probability: 1.0e-3");
+  if (noise.truncation == Truncation::FixedRegion) {
+    const std::string example = "fixed_region: [" + n_text + " half-widths in state units]";
+    if (noise.fixed_region.size() != n)
+      fail("noise.fixed_region", std::to_string(noise.fixed_region.size()) + " values",
+           n_text + " values (one per state)", example);
+    check_finite_list(noise.fixed_region, "noise.fixed_region", example);
+    for (std::size_t i = 0; i < n; ++i)
+      if (noise.fixed_region[i] <= 0)
+        fail(indexed("noise.fixed_region", i), format_number(noise.fixed_region[i]), "a number > 0", example);
+  } else if (!noise.fixed_region.empty()) {
+    throw ConfigError("noise.fixed_region", "given but noise.truncation is " + to_string(noise.truncation) +
+                                                "; set truncation: fixed_region to use it");
+  }
+}
+
+}  // namespace
+
+void Config::validate() const {
+  if (name.empty()) fail("name", "\"\"", "a non-empty name", "name: robot_reach_avoid");
+
+  const double state_points = check_grid(states, "states", "");
+  const std::size_t n = states.lb.size();
+  const std::size_t m = inputs ? inputs->lb.size() : 0;
+  const std::size_t p = disturbances ? disturbances->lb.size() : 0;
+  if (inputs) check_grid(*inputs, "inputs", "; omit `inputs` for an autonomous system");
+  if (disturbances) check_grid(*disturbances, "disturbances", "; omit `disturbances` when there are none");
+
+  for (const auto& constant : constants) {
+    const std::string key = "constants." + constant.first;
+    bool reserved = constant.first == "pi" || looks_like_variable(constant.first);
+    for (const auto& function : kFunctionNames) reserved = reserved || function == constant.first;
+    if (!is_identifier(constant.first) || reserved)
+      throw ConfigError(key, "got the name '" + constant.first +
+                                 "', expected a name of letters, digits and '_' that is not pi, a variable "
+                                 "(x0, u1, ...) or a function (example: constants: {tau: 10.0})");
+    if (!std::isfinite(constant.second)) fail(key, format_number(constant.second), "a finite number", "tau: 10.0");
+  }
+
+  if (!model.empty() && !dynamics.empty())
+    throw ConfigError("model", "both `model` and `dynamics` are given; use one (example: model: bmw320i)");
+  if (model.empty()) {
+    if (dynamics.empty())
+      throw ConfigError("dynamics", "missing, expected one expression per state dimension or a built-in `model` "
+                                    "(example: dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"])");
+    if (dynamics.size() != n)
+      fail("dynamics", std::to_string(dynamics.size()) + " expressions",
+           std::to_string(n) + ", one per state dimension (states.lb has " + std::to_string(n) + " values)",
+           "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]");
+    parse_dynamics(*this);
+  } else {
+    const BuiltinModelInfo* info = nullptr;
+    std::vector<std::string> names;
+    for (const auto& candidate : builtin_models()) {
+      names.push_back(candidate.name);
+      if (candidate.name == model) info = &candidate;
+    }
+    if (!info) fail("model", "'" + model + "'", "one of " + join(names), "model: bmw320i");
+    auto check_dims = [&](const char* key, std::size_t have, std::size_t want) {
+      if (have != want)
+        throw ConfigError(key, "model " + model + " needs " + std::to_string(want) + " dimensions, got " +
+                                   std::to_string(have) + " (" + info->description + ")");
+    };
+    check_dims("states.lb", n, info->state_dims);
+    check_dims("inputs.lb", m, info->input_dims);
+    check_dims("disturbances.lb", p, info->disturbance_dims);
+  }
+
+  check_noise(noise, n);
+
+  if (spec.horizon == 0) fail("spec.horizon", "0", "an integer >= 1 (number of time steps)", "horizon: 16");
+  switch (spec.type) {
+    case SpecType::Safety:
+      if (spec.target) throw ConfigError("spec.target", "given for spec.type safety; safety uses `safe` (or the whole grid)");
+      if (spec.avoid) throw ConfigError("spec.avoid", "given for spec.type safety; use reach_avoid, or `safe` for the set to stay in");
+      if (spec.safe) check_box(*spec.safe, "spec.safe", states);
+      break;
+    case SpecType::Reachability:
+    case SpecType::ReachAvoid:
+      if (spec.safe) throw ConfigError("spec.safe", "given for spec.type " + to_string(spec.type) + "; `safe` is for safety only");
+      if (!spec.target)
+        throw ConfigError("spec.target", "missing, expected the target box for " + to_string(spec.type) +
+                                             " (example: target: {lb: [5, 5], ub: [7, 7]})");
+      check_box(*spec.target, "spec.target", states);
+      if (spec.avoid) {
+        if (spec.type == SpecType::Reachability)
+          throw ConfigError("spec.avoid", "given for spec.type reachability; use reach_avoid to avoid a set");
+        check_box(*spec.avoid, "spec.avoid", states);
+        check_target_avoid_disjoint(*spec.target, *spec.avoid, states);
+      }
+      break;
+  }
+
+  if (!(compute.memory_fraction > 0 && compute.memory_fraction <= 1))
+    fail("compute.memory_fraction", format_number(compute.memory_fraction), "a fraction in (0, 1]",
+         "memory_fraction: 0.5");
+
+  const double policy_bytes = state_points * ((double(spec.horizon) + 1) * 8 + double(spec.horizon) * 4);
+  if (policy_bytes > kMaxPolicyBytes) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "grid too large: %.0f states x (%u+1 values x 8 bytes + %u inputs x 4 bytes) = %.1f GiB of "
+                  "policy arrays, more than the 16 GiB supported; use a larger states.eta or a shorter horizon",
+                  state_points, spec.horizon, spec.horizon, policy_bytes / (1024.0 * 1024 * 1024));
+    throw ConfigError("states", text);
+  }
+}
+
+}  // namespace amytiss

@@ -1,0 +1,76 @@
+#pragma once
+// OpenCL plumbing shared by the engine's parts: owning handles, error checks and the devices
+// visible through the ICD loader, with the choice among them that compute.device/platform/
+// device_name make.
+#include <CL/cl.h>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+
+namespace amytiss::detail {
+
+/// Name of an OpenCL error code ("CL_OUT_OF_RESOURCES"), or "OpenCL error".
+const char* cl_error_name(cl_int code);
+/// Throws DeviceError "<call> failed: <name> (<code>)" unless code is CL_SUCCESS.
+void check(cl_int code, const char* call);
+
+/// Owning handle of an OpenCL object, released with Release.
+template <typename T, cl_int (*Release)(T)>
+struct ClHandle {
+  T handle = nullptr;
+  ClHandle() = default;
+  explicit ClHandle(T h) : handle(h) {}
+  ClHandle(const ClHandle&) = delete;
+  ClHandle& operator=(const ClHandle&) = delete;
+  ClHandle(ClHandle&& other) noexcept : handle(other.handle) { other.handle = nullptr; }
+  ClHandle& operator=(ClHandle&& other) noexcept {
+    std::swap(handle, other.handle);
+    return *this;
+  }
+  ~ClHandle() {
+    if (handle) Release(handle);
+  }
+  T get() const { return handle; }
+};
+using Context = ClHandle<cl_context, clReleaseContext>;
+using Queue = ClHandle<cl_command_queue, clReleaseCommandQueue>;
+using Program = ClHandle<cl_program, clReleaseProgram>;
+using Kernel = ClHandle<cl_kernel, clReleaseKernel>;
+using Buffer = ClHandle<cl_mem, clReleaseMemObject>;
+
+/// A string property of a platform or a device; "?" when the query fails.
+std::string platform_string(cl_platform_id platform, cl_platform_info what);
+std::string device_string(cl_device_id device, cl_device_info what);
+
+struct DeviceInfo {
+  std::size_t platform_index = 0, device_index = 0;
+  cl_platform_id platform = nullptr;
+  cl_device_id device = nullptr;
+  std::string platform_name, device_name;
+  cl_device_type type = 0;
+  std::uint64_t global_memory = 0, max_allocation = 0;
+  cl_uint compute_units = 0;
+  std::size_t max_work_group = 1;
+  bool fp64 = false;
+  bool is_gpu() const { return (type & CL_DEVICE_TYPE_GPU) != 0; }
+  bool is_cpu() const { return (type & CL_DEVICE_TYPE_CPU) != 0; }
+  std::string label() const { return platform_name + " / " + device_name; }
+  std::string type_name() const {
+    return is_gpu() ? "GPU" : is_cpu() ? "CPU" : (type & CL_DEVICE_TYPE_ACCELERATOR) ? "accelerator" : "other";
+  }
+};
+
+/// Every device of every platform, in platform then device order.
+std::vector<DeviceInfo> enumerate_devices();
+
+/// The device that `compute` selects (auto: the first GPU, else the first CPU device; cpu / gpu
+/// missing: another device, with a warning note). Devices without double precision are skipped
+/// with a note. Throws DeviceError when no device matches.
+DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes);
+
+}  // namespace amytiss::detail
