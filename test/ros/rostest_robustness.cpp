@@ -1,8 +1,12 @@
 // rostest: hostile expressions (parameters and goal) are refused on /amytiss/status and the node
-// stays up; a zeroed policy file is refused and computed again.
+// stays up; a zeroed policy file is refused and computed again; /diagnostics of both nodes.
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
 
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
@@ -99,6 +103,43 @@ TEST_F(RobustnessTest, AZeroedPolicyFileIsRefusedAndComputedAgain) {
   EXPECT_NO_THROW(amytiss::read_policy_file(file));
   const std::string new_run = status_.latest().run_id;
   ASSERT_TRUE(amytiss_test::poll_until([&] { return call().run_id == new_run; }, kNoticeWaitSeconds));
+}
+
+TEST_F(RobustnessTest, BothNodesPublishDiagnostics) {
+  std::mutex mutex;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> latest;  // by status name
+  const ros::Subscriber subscriber = handle_.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const auto& status : array->status) latest[status.name] = status;
+      });
+  const auto find = [&](const std::string& part, diagnostic_msgs::DiagnosticStatus& out) {
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [name, status] : latest)
+      if (name.find(part) != std::string::npos) {
+        out = status;
+        return true;
+      }
+    return false;
+  };
+  diagnostic_msgs::DiagnosticStatus server, synthesizer;
+  ASSERT_TRUE(amytiss_test::poll_until([&] { return find("policy server", server) && find(": synthesizer", synthesizer); },
+                                       kNoticeWaitSeconds));
+  const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
+    for (const auto& pair : status.values)
+      if (pair.key == key) return pair.value;
+    return std::string("<missing>");
+  };
+  const amytiss_msgs::PolicyStatus current = status_.latest();
+  EXPECT_EQ(diagnostic_msgs::DiagnosticStatus::OK, server.level) << server.message;
+  EXPECT_EQ("True", value(server, "policy loaded"));
+  EXPECT_EQ(current.config_name, value(server, "policy name"));
+  EXPECT_EQ(current.config_hash, value(server, "policy config_hash"));
+  EXPECT_EQ(current.run_id, value(server, "policy run_id"));
+  EXPECT_EQ("running", value(server, "synthesizer"));
+  EXPECT_NE("<missing>", value(server, "policy age (s)"));
+  EXPECT_EQ(current.run_id, value(synthesizer, "run_id"));
+  EXPECT_EQ(current.device, value(synthesizer, "device"));
 }
 
 }  // namespace
