@@ -2,12 +2,18 @@
 """Pictures of a closed-loop run (called by the plant simulator; usable by hand).
 
   plot_episodes.py --csv RUN.csv --policy POLICY.h5 --initial-state "x0, x1, ..." \
-                   --trajectories OUT1.png --values OUT2.png
+                   --trajectories OUT1.png --values OUT2.png \
+                   [--footprint "length, width, rear_to_reference, x_index, y_index, yaw_index"] \
+                   [--scene SCENE.yaml]
 
 OUT1: the episodes' trajectories over the sets in the x0/x1 plane (success green, failure red),
 with the grid bounds, target (green), avoid (red) and safe (blue) boxes from the configuration
-stored in the policy file. OUT2: V_0 over the x0/x1 slice of the grid, the other coordinates at
-the start state's cell. Needs python3-matplotlib, python3-h5py, python3-yaml (Debian).
+stored in the policy file. With --footprint (a car: metres, the state coordinates of its reference
+point and yaw) the car's body is drawn at every step of every episode; with --scene the picture's
+scene (config/bmw_parking_scene.yaml: the bay, parked cars and kerbs, metres) is drawn under it,
+and every footprint is checked against the scene's obstacles (the result is printed and in the
+title). OUT2: V_0 over the x0/x1 slice of the grid, the other coordinates at the start state's
+cell. Needs python3-matplotlib, python3-h5py, python3-yaml (Debian).
 """
 import argparse
 import csv
@@ -20,7 +26,7 @@ import h5py  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 
 
 def read_policy(path):
@@ -38,13 +44,69 @@ def read_policy(path):
 
 
 def read_episodes(path):
+    """{episode: {"states": array (steps, state dims), "x0": [...], "x1": [...], "success": bool}}"""
     episodes = {}
     with open(path) as f:
-        for row in csv.DictReader(f):
-            e = episodes.setdefault(int(row["episode"]), {"x0": [], "x1": [], "success": row["success"] == "1"})
-            e["x0"].append(float(row["x0"]))
-            e["x1"].append(float(row["x1"]) if "x1" in row else 0.0)
+        reader = csv.DictReader(f)
+        state_keys = [k for k in reader.fieldnames if k.startswith("x")]
+        for row in reader:
+            e = episodes.setdefault(int(row["episode"]), {"states": [], "success": row["success"] == "1"})
+            e["states"].append([float(row[k]) for k in state_keys])
+    for e in episodes.values():
+        e["states"] = np.array(e["states"])
+        e["x0"] = e["states"][:, 0]
+        e["x1"] = e["states"][:, 1] if e["states"].shape[1] > 1 else np.zeros(len(e["states"]))
     return episodes
+
+
+def body_corners(state, footprint):
+    """The car's body at `state`: 4 corners (x, y) in metres, counter-clockwise."""
+    length, width, rear, xi, yi, yawi = footprint
+    x, y, yaw = state[int(xi)], state[int(yi)], state[int(yawi)]
+    forward, left = np.array([np.cos(yaw), np.sin(yaw)]), np.array([-np.sin(yaw), np.cos(yaw)])
+    back = np.array([x, y]) - rear * forward
+    front = back + length * forward
+    half = 0.5 * width * left
+    return np.array([back - half, front - half, front + half, back + half])
+
+
+def overlaps(polygon, box):
+    """Whether a convex polygon and an axis-aligned box {lb, ub} share interior (separating axes)."""
+    rect = np.array([[box["lb"][0], box["lb"][1]], [box["ub"][0], box["lb"][1]],
+                     [box["ub"][0], box["ub"][1]], [box["lb"][0], box["ub"][1]]])
+    for shape in (polygon, rect):
+        for i in range(len(shape)):
+            edge = shape[(i + 1) % len(shape)] - shape[i]
+            axis = np.array([-edge[1], edge[0]])
+            a, b = polygon @ axis, rect @ axis
+            if a.max() <= b.min() or b.max() <= a.min():
+                return False
+    return True
+
+
+def draw_scene(ax, scene):
+    for bay in scene.get("bays", []):
+        x0, y0, x1, y1 = bay["lb"][0], bay["lb"][1], bay["ub"][0], bay["ub"][1]
+        ax.plot([x0, x0, x1, x1], [y1, y0, y0, y1], "-", color="0.55", lw=1.2)
+    for i, obstacle in enumerate(scene.get("obstacles", [])):
+        (x0, y0), (x1, y1) = obstacle["lb"], obstacle["ub"]
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fc="0.65", ec="0.35", lw=0.8, zorder=1,
+                               label="parked cars, kerbs" if i == 0 else None))
+        if obstacle.get("label"):
+            ax.text(0.5 * (x0 + x1), 0.5 * (y0 + y1), obstacle["label"], ha="center", va="center", fontsize=6,
+                    rotation=90 if y1 - y0 > x1 - x0 else 0, color="0.2")
+
+
+def footprint_clearance(episodes, footprint, scene):
+    """Lines about footprints that overlap an obstacle of the scene (empty when none does)."""
+    touches = []
+    for number, e in sorted(episodes.items()):
+        for step, state in enumerate(e["states"]):
+            corners = body_corners(state, footprint)
+            for obstacle in scene.get("obstacles", []):
+                if overlaps(corners, obstacle):
+                    touches.append(f"episode {number} step {step}: the body overlaps {obstacle.get('label', 'an obstacle')}")
+    return touches
 
 
 def box_xy(box):
@@ -53,7 +115,7 @@ def box_xy(box):
     return lb[0], y0, ub[0] - lb[0], y1 - y0
 
 
-def draw_sets(ax, policy):
+def draw_sets(ax, policy, suffix=""):
     lb, eta, counts = policy["lb"], policy["eta"], policy["counts"]
     lo = lb - eta / 2
     hi = lb + (counts - 1) * eta + eta / 2
@@ -65,7 +127,7 @@ def draw_sets(ax, policy):
     for name, style in styles.items():
         if spec.get(name):
             x, y, w, h = box_xy(spec[name])
-            ax.add_patch(Rectangle((x, y), w, h, label=name, **style))
+            ax.add_patch(Rectangle((x, y), w, h, label=name + suffix, **style))
     ax.set_xlim(lo[0] - eta[0], hi[0] + eta[0])
     ax.set_ylim(y0 - (eta[1] if len(eta) > 1 else 0.5), y1 + (eta[1] if len(eta) > 1 else 0.5))
 
@@ -77,6 +139,8 @@ def main():
     parser.add_argument("--initial-state", required=True, help="comma-separated, state units")
     parser.add_argument("--trajectories", required=True)
     parser.add_argument("--values", required=True)
+    parser.add_argument("--footprint", help="length, width, rear_to_reference (m), x_index, y_index, yaw_index")
+    parser.add_argument("--scene", help="YAML: bays and obstacles as boxes {lb: [x, y], ub: [x, y], label} (m)")
     args = parser.parse_args()
 
     policy = read_policy(args.policy)
@@ -84,18 +148,56 @@ def main():
     start = np.array([float(v) for v in args.initial_state.split(",")])
     name = policy["config"].get("name", "policy")
 
-    fig, ax = plt.subplots(figsize=(6.5, 6))
-    draw_sets(ax, policy)
+    footprint = [float(v) for v in args.footprint.split(",")] if args.footprint else None
+    scene = {}
+    if args.scene:
+        with open(args.scene) as f:
+            scene = yaml.safe_load(f) or {}
+    fig, ax = plt.subplots(figsize=(8, 7) if footprint else (6.5, 6))
+    if scene:
+        draw_scene(ax, scene)
+    draw_sets(ax, policy, " (reference point)" if footprint else "")
     successes = sum(e["success"] for e in episodes.values())
-    for e in episodes.values():
-        ax.plot(e["x0"], e["x1"], "-", color="tab:green" if e["success"] else "tab:red", lw=1, alpha=0.7)
-        ax.plot(e["x0"][-1], e["x1"][-1], "o", color="tab:green" if e["success"] else "tab:red", ms=3)
+    # The body along the first episode's path (every other step) and at the end of every episode;
+    # the clearance check below looks at every step of every episode.
+    for number, e in sorted(episodes.items()):
+        color = "tab:green" if e["success"] else "tab:red"
+        if footprint:
+            first = number == min(episodes)
+            for step, state in enumerate(e["states"]):
+                if (first and step % 2 == 0) or step == len(e["states"]) - 1:
+                    ax.add_patch(Polygon(body_corners(state, footprint), closed=True, fill=False, ec=color,
+                                         lw=0.8 if first else 0.5, alpha=0.7 if first else 0.4))
+        ax.plot(e["x0"], e["x1"], "-", color=color, lw=1, alpha=0.7)
+        ax.plot(e["x0"][-1], e["x1"][-1], "o", color=color, ms=3)
     ax.plot(start[0], start[1] if len(start) > 1 else 0.0, "k*", ms=12, label="start")
-    ax.set_xlabel("x0")
-    ax.set_ylabel("x1")
-    ax.set_title(f"{name}: {successes}/{len(episodes)} episodes succeeded")
-    ax.legend(loc="best", fontsize=8)
-    ax.set_aspect("auto")
+    title = f"{name}: {successes}/{len(episodes)} episodes succeeded"
+    if scene.get("view"):
+        ax.set_xlim(scene["view"]["lb"][0], scene["view"]["ub"][0])
+        ax.set_ylim(scene["view"]["lb"][1], scene["view"]["ub"][1])
+    if footprint:
+        ax.add_patch(Polygon(body_corners(start, footprint), closed=True, fill=False, ec="k", lw=1.5, label="car at start"))
+        ax.set_xlabel("x (m), position of the reference point")
+        ax.set_ylabel("y (m)")
+        turns = [np.degrees(e["states"][-1][int(footprint[5])] - e["states"][0][int(footprint[5])])
+                 for e in episodes.values() if e["success"]]
+        if turns:
+            title += f"; yaw change {min(turns):.0f} to {max(turns):.0f} deg"
+        if scene:
+            touches = footprint_clearance(episodes, footprint, scene)
+            for line in touches:
+                print(line)
+            verdict = "footprint clear of every obstacle at every step" if not touches else \
+                f"footprint overlaps an obstacle at {len(touches)} steps"
+            print(f"{name}: {verdict}")
+            title += "\n" + verdict
+        ax.set_aspect("equal")
+    else:
+        ax.set_xlabel("x0")
+        ax.set_ylabel("x1")
+        ax.set_aspect("auto")
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="best", fontsize=7)
     fig.tight_layout()
     fig.savefig(args.trajectories, dpi=120)
     plt.close(fig)
@@ -122,7 +224,7 @@ def main():
         ax.set_ylabel("x1")
         ax.legend(loc="best", fontsize=8)
         if len(lb) > 2:
-            others = ", ".join(f"x{i} = {lb[i] + index[i] * eta[i]:g}" for i in range(2, len(lb)))
+            others = ", ".join(f"x{i} = {round(lb[i] + index[i] * eta[i], 9):g}" for i in range(2, len(lb)))
             ax.set_title(f"{name}: V_0 over x0/x1 at {others}", fontsize=9)
         else:
             ax.set_title(f"{name}: V_0 over x0/x1")

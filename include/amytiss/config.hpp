@@ -43,6 +43,19 @@ struct NoiseConfig {
   std::vector<double> fixed_region;
 };
 
+/// How one time step of a continuous-time model is integrated (docs/configuration.md, `integrator`).
+enum class IntegrationMethod { Euler, Rk4 };
+
+struct IntegratorConfig {
+  IntegrationMethod method = IntegrationMethod::Euler;  ///< explicit Euler or classical Runge-Kutta 4
+  unsigned substeps = 1;  ///< equal sub-steps of length tau/substeps per time step, >= 1
+  /// Length of one time step in seconds, > 0. Absent: a built-in model's own step; for `dynamics`
+  /// expressions, absent means the expressions are the discrete map x(k+1) itself (no integration).
+  std::optional<double> tau;
+  /// The default: one Euler step of the model's own length (expressions: the discrete map).
+  bool is_default() const { return method == IntegrationMethod::Euler && substeps == 1 && !tau; }
+};
+
 enum class SpecType { Safety, Reachability, ReachAvoid };
 
 struct SpecConfig {
@@ -55,10 +68,15 @@ struct SpecConfig {
 
 enum class DeviceKind { Auto, Cpu, Gpu, Reference };
 enum class TransitionStorage { Auto, Stored, OnTheFly };
+/// How the OpenCL engine computes the expected next values (docs/engine.md, "Two sweeps").
+enum class SweepChoice { Auto, Dense, Factored };
 
 struct ComputeConfig {
   DeviceKind device = DeviceKind::Auto;
   TransitionStorage transitions = TransitionStorage::Auto;
+  /// auto: the factored sweep where the dynamics allow it and it saves at least half the
+  /// multiply-adds, else dense; dense / factored: that one (factored that cannot run: error).
+  SweepChoice sweep = SweepChoice::Auto;
   /// Optional OpenCL platform/device selection: a 0-based index ("1") or a case-insensitive
   /// substring of the platform or device name ("nvidia"). Empty: any.
   std::string platform;
@@ -74,7 +92,10 @@ struct Config {
   std::optional<GridSpec> disturbances;  ///< absent: no adversary
   std::map<std::string, double> constants;
   std::vector<std::string> dynamics;     ///< one expression per state dimension, or empty with model
-  std::string model;                     ///< built-in model name ("bmw320i", "vehicle3d"), or empty
+  std::string model;                     ///< built-in model name ("bmw320i", "bmw320i_ks", "vehicle3d"), or empty
+  /// Integration of one time step. Default: built-in models take one Euler step of their own length,
+  /// expressions are the discrete map; with a tau, expressions are the vector field dx/dt.
+  IntegratorConfig integrator;
   NoiseConfig noise;
   SpecConfig spec;
   ComputeConfig compute;
@@ -101,8 +122,10 @@ std::string config_hash(const Config& config);
 std::string to_string(SpecType);
 std::string to_string(DeviceKind);
 std::string to_string(TransitionStorage);
+std::string to_string(SweepChoice);
 std::string to_string(NoiseType);
 std::string to_string(Distribution);
 std::string to_string(Truncation);
+std::string to_string(IntegrationMethod);
 
 }  // namespace amytiss

@@ -35,6 +35,11 @@ struct PhaseReport {
   double seconds = 0;
   double pairs_per_second = 0; ///< state-input pairs processed per second (0 if not applicable)
   double multiply_adds = 0;    ///< multiply-adds done in the phase (0 if not counted)
+  /// Operand bytes of the phase's kernels: values and records they load, entries they store (an
+  /// upper bound of the memory traffic: caches serve much of it). 0 if not counted.
+  double bytes = 0;
+  /// A breakdown of the steps' time by kernel (with profile): already counted in the steps.
+  bool breakdown = false;
 };
 /// How much an engine note matters: Info is a fact about the run (storage chosen, memory used);
 /// Warning says the run differs from what was asked (another device, on-the-fly storage).
@@ -62,6 +67,9 @@ struct SynthesisReport {
   std::string transitions;            ///< "stored" or "on_the_fly", with the reason
   std::vector<PhaseReport> phases;
   std::size_t device_bytes = 0;       ///< peak device memory allocated by the engine
+  /// The device's double-precision multiply-add peak (0: unknown) and how it was derived.
+  double peak_multiply_adds_per_second = 0;
+  std::string peak_basis;
   std::size_t host_peak_bytes = 0;    ///< peak resident set of the process (VmHWM)
   std::vector<EngineNote> notes;      ///< device choice and fallback, storage, chunking, ...
 };

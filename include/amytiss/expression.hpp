@@ -16,9 +16,11 @@
 // Variables: x0.., u0.., w0.. (state, input, disturbance components). Constants: names given to
 // parse() (and pi). Functions: sin cos tan asin acos atan atan2 exp log sqrt pow abs min max floor
 // ceil, plus if(cond, a, b). Comparisons and logic give 1 or 0. Also: `cond ? a : b`.
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace amytiss {
 
@@ -33,6 +35,11 @@ constexpr std::size_t kMaxExpressionNodes = 10000;   // numbers, variables, oper
 std::string expression_excerpt(const std::string& text);
 
 struct ExpressionNode;  // defined in the .cpp
+
+/// Which components an expression reads: sorted, distinct indices of x, u and w.
+struct VariableUse {
+  std::vector<std::size_t> states, inputs, disturbances;
+};
 
 class Expression {
  public:
@@ -50,6 +57,10 @@ class Expression {
   std::string to_c() const;
 
   const std::string& text() const { return text_; }
+
+  /// The variables that occur in the expression (after constant substitution). The value depends
+  /// on no other component.
+  VariableUse variables() const;
 
  private:
   std::shared_ptr<const ExpressionNode> root_;

@@ -87,6 +87,9 @@ class NoiseModel {
   /// Clipped window for post mean `mean`: first[i]..last[i] (inclusive grid indices). Returns
   /// false when the window misses the grid in some dimension (all mass leaves the grid).
   bool window(const Grid& states, const double* mean, std::int64_t* first, std::int64_t* last) const;
+  /// The same for one dimension: the window of post coordinate `mean` along `dim`.
+  bool dimension_window(const Grid& states, std::size_t dim, double mean, std::int64_t* first,
+                        std::int64_t* last) const;
 
   /// Probability T(x'|x,u,w) of the state cell `target` (flat index) for post mean `mean` from
   /// current state x (used by the reference engine and tests): 0 outside the window.

@@ -32,6 +32,7 @@ constexpr const char* kUsage =
     "  --config FILE                      YAML configuration (docs/configuration.md)\n"
     "  --device auto|cpu|gpu|reference    overrides compute.device\n"
     "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
+    "  --sweep auto|dense|factored        overrides compute.sweep (docs/engine.md)\n"
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
     "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
     "  --profile                          per-phase timing, rates and memory table\n"
@@ -52,6 +53,7 @@ struct Options {
   std::string config_path;
   std::string device;       // empty: the configuration's
   std::string transitions;  // empty: the configuration's
+  std::string sweep;        // empty: the configuration's
   std::string platform;
   std::string output;
   bool profile = false;
@@ -73,6 +75,7 @@ Options parse_options(int argc, char** argv) {
     if (arg == "--config") options.config_path = value();
     else if (arg == "--device") options.device = value();
     else if (arg == "--transitions") options.transitions = value();
+    else if (arg == "--sweep") options.sweep = value();
     else if (arg == "--platform") options.platform = value();
     else if (arg == "--output" || arg == "-o") options.output = value();
     else if (arg == "--profile") options.profile = true;
@@ -159,7 +162,7 @@ bool is_step_phase(const PhaseReport& phase) { return phase.name.rfind("step", 0
 double compute_seconds(const SynthesisReport& report) {
   double total = 0;
   for (const auto& phase : report.phases)
-    if (phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
+    if (!phase.breakdown && phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
   return total;
 }
 
@@ -168,6 +171,7 @@ void print_phase_times(const SynthesisReport& report) {
   double step_seconds = 0;
   std::size_t steps = 0;
   for (const auto& phase : report.phases) {
+    if (phase.breakdown) continue;
     if (is_step_phase(phase)) {
       step_seconds += phase.seconds;
       ++steps;
@@ -180,21 +184,32 @@ void print_phase_times(const SynthesisReport& report) {
                 format_seconds(step_seconds).c_str());
 }
 
+// Every kernel finishes before its phase's clock stops (profile), so the rates are the device's.
 void print_profile(const SynthesisReport& report) {
+  const double peak = report.peak_multiply_adds_per_second;
   std::printf("profile (%s):\n", report.device.c_str());
-  std::printf("  %-22s %10s %14s %16s %10s\n", "phase", "seconds", "pairs/s", "multiply-adds",
-              "GMAC/s");
-  double total_seconds = 0, total_multiply_adds = 0;
+  if (peak > 0)
+    std::printf("  double multiply-add peak %.0f GMAC/s: %s\n", peak / 1e9, report.peak_basis.c_str());
+  std::printf("  %-28s %10s %14s %14s %9s %7s %11s\n", "phase", "seconds", "pairs/s", "multiply-adds", "GMAC/s",
+              "% peak", "GB/s (ops)");
+  auto print_row = [&](const std::string& name, double seconds, double pairs_per_second, double multiply_adds,
+                       double bytes) {
+    const double rate = seconds > 0 ? multiply_adds / seconds : 0.0;
+    std::printf("  %-28s %10.4f %14.4g %14.4g %9.3f %7.2f %11.2f\n", name.c_str(), seconds, pairs_per_second,
+                multiply_adds, rate / 1e9, peak > 0 ? 100.0 * rate / peak : 0.0,
+                seconds > 0 ? bytes / seconds / 1e9 : 0.0);
+  };
+  double total_seconds = 0, total_multiply_adds = 0, total_bytes = 0;
   for (const auto& phase : report.phases) {
-    total_seconds += phase.seconds;
-    total_multiply_adds += phase.multiply_adds;
-    const double rate = phase.seconds > 0 ? phase.multiply_adds / phase.seconds / 1e9 : 0.0;
-    std::printf("  %-22s %10.4f %14.4g %16.4g %10.3f\n", phase.name.c_str(), phase.seconds,
-                phase.pairs_per_second, phase.multiply_adds, rate);
+    if (!phase.breakdown) {
+      total_seconds += phase.seconds;
+      total_multiply_adds += phase.multiply_adds;
+      total_bytes += phase.bytes;
+    }
+    print_row((phase.breakdown ? "  " : "") + phase.name, phase.seconds, phase.pairs_per_second,
+              phase.multiply_adds, phase.bytes);
   }
-  std::printf("  %-22s %10.4f %14s %16.4g %10.3f\n", "total", total_seconds, "",
-              total_multiply_adds,
-              total_seconds > 0 ? total_multiply_adds / total_seconds / 1e9 : 0.0);
+  print_row("total", total_seconds, 0, total_multiply_adds, total_bytes);
   std::printf("  device memory: %s, host peak (VmHWM): %s\n",
               format_bytes(double(report.device_bytes)).c_str(),
               format_bytes(double(std::max(report.host_peak_bytes, peak_resident_bytes()))).c_str());
@@ -246,6 +261,7 @@ int run(const Options& options) {
   if (!options.device.empty()) config.compute.device = parse_enum_option<DeviceKind>("--device", options.device);
   if (!options.transitions.empty())
     config.compute.transitions = parse_enum_option<TransitionStorage>("--transitions", options.transitions);
+  if (!options.sweep.empty()) config.compute.sweep = parse_enum_option<SweepChoice>("--sweep", options.sweep);
   if (!options.platform.empty()) config.compute.platform = options.platform;
   const Abstraction abstraction = Abstraction::from_config(config);
   const double setup_seconds = seconds_since(setup_start);

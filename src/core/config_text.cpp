@@ -42,6 +42,13 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
     text += "dynamics:\n";
     for (const auto& expression : config.dynamics) text += "  - " + quoted(expression) + "\n";
   }
+  // The default integrator is left out, so configurations without the key keep their text and hash.
+  if (!config.integrator.is_default()) {
+    text += "integrator: {method: " + to_string(config.integrator.method) +
+            ", substeps: " + std::to_string(config.integrator.substeps);
+    if (config.integrator.tau) text += ", tau: " + format_number(*config.integrator.tau);
+    text += "}\n";
+  }
   const NoiseConfig& noise = config.noise;
   text += "noise:\n";
   text += "  type: " + to_string(noise.type) + "\n";
@@ -63,6 +70,7 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
     text += "compute:\n";
     text += "  device: " + to_string(compute.device) + "\n";
     text += "  transitions: " + to_string(compute.transitions) + "\n";
+    text += "  sweep: " + to_string(compute.sweep) + "\n";
     text += "  platform: " + quoted(compute.platform) + "\n";
     text += "  device_name: " + quoted(compute.device_name) + "\n";
     text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";

@@ -216,6 +216,24 @@ void check_noise(const NoiseConfig& noise, std::size_t n) {
   }
 }
 
+void check_integrator(const IntegratorConfig& integrator, bool expressions, std::size_t n) {
+  const char* const example = "integrator: {method: rk4, substeps: 4, tau: 0.1}";
+  if (integrator.substeps < 1 || integrator.substeps > kMaxIntegratorSubsteps)
+    fail("integrator.substeps", std::to_string(integrator.substeps),
+         "an integer in [1, " + std::to_string(kMaxIntegratorSubsteps) + "]", example);
+  if (integrator.tau && !(std::isfinite(*integrator.tau) && *integrator.tau > 0))
+    fail("integrator.tau", format_number(*integrator.tau), "a time step in seconds > 0", example);
+  if (expressions && !integrator.is_default() && !integrator.tau)
+    throw ConfigError("integrator.tau",
+                      "missing: with an integrator, `dynamics` are the vector field dx/dt and need the length of "
+                      "one time step in seconds (example: " + std::string(example) + ")");
+  const bool integrated = !expressions || integrator.tau;
+  if (integrated && n > kMaxIntegratorStates)
+    throw ConfigError("integrator", "an integrated model has at most " + std::to_string(kMaxIntegratorStates) +
+                                        " state dimensions, got " + std::to_string(n) +
+                                        "; give `dynamics` as the discrete map without `integrator`");
+}
+
 }  // namespace
 
 void Config::validate() const {
@@ -267,6 +285,7 @@ void Config::validate() const {
     check_dims("inputs.lb", m, info->input_dims);
     check_dims("disturbances.lb", p, info->disturbance_dims);
   }
+  check_integrator(integrator, model.empty(), n);
 
   check_noise(noise, n);
 

@@ -96,8 +96,8 @@ Box read_box(const YAML::Node& node, const std::string& key, const std::string& 
 }  // namespace
 
 Config config_from_yaml(const YAML::Node& root) {
-  check_keys(root, "", {"name", "states", "inputs", "disturbances", "constants", "dynamics", "model", "noise", "spec",
-                        "compute"},
+  check_keys(root, "", {"name", "states", "inputs", "disturbances", "constants", "dynamics", "model", "integrator", "noise",
+                        "spec", "compute"},
              "name: robot_reach_avoid");
   Config config;
   config.name = read_string(required(root, "name", "name", "name: robot_reach_avoid"), "name", "name: robot_reach_avoid");
@@ -121,6 +121,20 @@ Config config_from_yaml(const YAML::Node& root) {
       config.dynamics.push_back(read_string(dynamics[i], indexed("dynamics", i), dynamics_example));
   }
   if (present(root["model"])) config.model = read_string(root["model"], "model", "model: bmw320i");
+  if (present(root["integrator"])) {
+    const char* const example = "integrator: {method: rk4, substeps: 4}";
+    const YAML::Node integrator = root["integrator"];
+    check_keys(integrator, "integrator", {"method", "substeps", "tau"}, example);
+    if (present(integrator["method"]))
+      config.integrator.method = read_enum<IntegrationMethod>(integrator["method"], "integrator.method", "method: rk4");
+    if (present(integrator["substeps"])) {
+      const double substeps = read_number(integrator["substeps"], "integrator.substeps", "substeps: 4");
+      if (!(substeps >= 0 && substeps == std::floor(substeps) && substeps <= 1e9))
+        fail("integrator.substeps", integrator["substeps"].Scalar(), "an integer >= 1", "substeps: 4");
+      config.integrator.substeps = static_cast<unsigned>(substeps);
+    }
+    if (present(integrator["tau"])) config.integrator.tau = read_number(integrator["tau"], "integrator.tau", "tau: 0.1");
+  }
 
   const YAML::Node noise = required(root, "noise", "noise", "noise: {covariance: [0.75, 0.75]}");
   check_keys(noise, "noise", {"type", "distribution", "covariance", "half_width", "truncation", "cutting_probability",
@@ -173,11 +187,13 @@ Config config_from_yaml(const YAML::Node& root) {
 
   if (present(root["compute"])) {
     const YAML::Node compute = root["compute"];
-    check_keys(compute, "compute", {"device", "transitions", "platform", "device_name", "memory_fraction"},
+    check_keys(compute, "compute", {"device", "transitions", "sweep", "platform", "device_name", "memory_fraction"},
                "compute: {device: auto}");
     if (present(compute["device"]))
       config.compute.device = read_enum<DeviceKind>(
           compute["device"], "compute.device", "device: auto");
+    if (present(compute["sweep"]))
+      config.compute.sweep = read_enum<SweepChoice>(compute["sweep"], "compute.sweep", "sweep: auto");
     if (present(compute["transitions"]))
       config.compute.transitions = read_enum<TransitionStorage>(
           compute["transitions"], "compute.transitions", "transitions: auto");

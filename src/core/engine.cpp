@@ -16,7 +16,10 @@ Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisRe
   try {
     return attempt(options, &first_report);
   } catch (const DeviceError& failure) {
-    if (options.compute.device == DeviceKind::Cpu) throw;
+    // Only `auto` without a platform or device selection may run elsewhere than asked.
+    const bool chosen_by_engine = options.compute.device == DeviceKind::Auto && options.compute.platform.empty() &&
+                                  options.compute.device_name.empty();
+    if (!chosen_by_engine) throw;
     ComputeConfig on_cpu = options.compute;
     on_cpu.device = DeviceKind::Cpu;
     on_cpu.platform.clear();

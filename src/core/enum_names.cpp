@@ -21,6 +21,12 @@ const std::vector<std::pair<const char*, TransitionStorage>>& enum_names() {
   return names;
 }
 template <>
+const std::vector<std::pair<const char*, SweepChoice>>& enum_names() {
+  static const std::vector<std::pair<const char*, SweepChoice>> names = {
+      {"auto", SweepChoice::Auto}, {"dense", SweepChoice::Dense}, {"factored", SweepChoice::Factored}};
+  return names;
+}
+template <>
 const std::vector<std::pair<const char*, NoiseType>>& enum_names() {
   static const std::vector<std::pair<const char*, NoiseType>> names = {{"additive", NoiseType::Additive},
                                                                        {"multiplicative", NoiseType::Multiplicative}};
@@ -37,6 +43,12 @@ const std::vector<std::pair<const char*, Truncation>>& enum_names() {
   static const std::vector<std::pair<const char*, Truncation>> names = {
       {"none", Truncation::None}, {"fixed_region", Truncation::FixedRegion},
       {"cutting_probability", Truncation::CuttingProbability}};
+  return names;
+}
+template <>
+const std::vector<std::pair<const char*, IntegrationMethod>>& enum_names() {
+  static const std::vector<std::pair<const char*, IntegrationMethod>> names = {{"euler", IntegrationMethod::Euler},
+                                                                               {"rk4", IntegrationMethod::Rk4}};
   return names;
 }
 template <>
@@ -73,9 +85,11 @@ std::string name_of(Enum value) {
 std::string to_string(SpecType value) { return name_of(value); }
 std::string to_string(DeviceKind value) { return name_of(value); }
 std::string to_string(TransitionStorage value) { return name_of(value); }
+std::string to_string(SweepChoice value) { return name_of(value); }
 std::string to_string(NoiseType value) { return name_of(value); }
 std::string to_string(Distribution value) { return name_of(value); }
 std::string to_string(Truncation value) { return name_of(value); }
+std::string to_string(IntegrationMethod value) { return name_of(value); }
 std::string to_string(Phase value) { return name_of(value); }
 std::string to_string(NoteSeverity value) { return name_of(value); }
 std::string to_string(NoteKind value) { return name_of(value); }

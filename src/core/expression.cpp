@@ -652,6 +652,30 @@ double Expression::evaluate(const double* x, const double* u, const double* w) c
 
 std::string Expression::to_c() const { return to_c_node(*root_); }
 
+VariableUse Expression::variables() const {
+  std::vector<char> seen[3];
+  // An explicit stack: the walk's depth must not depend on the expression's nesting.
+  std::vector<const ExpressionNode*> pending{root_.get()};
+  while (!pending.empty()) {
+    const ExpressionNode* node = pending.back();
+    pending.pop_back();
+    if (node->kind == NodeKind::Variable) {
+      std::vector<char>& space = seen[static_cast<int>(node->space)];
+      if (space.size() <= node->index) space.resize(node->index + 1, 0);
+      space[node->index] = 1;
+    }
+    for (const auto& child : node->children) pending.push_back(child.get());
+  }
+  auto indices = [](const std::vector<char>& flags) {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < flags.size(); ++i)
+      if (flags[i]) out.push_back(i);
+    return out;
+  };
+  return {indices(seen[int(VariableSpace::State)]), indices(seen[int(VariableSpace::Input)]),
+          indices(seen[int(VariableSpace::Disturbance)])};
+}
+
 }  // namespace amytiss
 
 namespace amytiss {

@@ -406,21 +406,26 @@ double NoiseModel::box_mass_with(const double* lo, const double* hi, const doubl
 }
 
 bool NoiseModel::window(const Grid& states, const double* mean, std::int64_t* first, std::int64_t* last) const {
-  for (std::size_t i = 0; i < dims_; ++i) {
-    const auto count = static_cast<std::int64_t>(counts_[i]);
-    if (whole_grid_dims_[i]) {
-      first[i] = 0;
-      last[i] = count - 1;
-      continue;
-    }
-    // A non-finite post state carries no mass onto the grid.
-    if (!std::isfinite(mean[i])) return false;
-    const std::int64_t center = states.nearest(i, mean[i]);
-    const std::int64_t half = window_half_cells_[i];
-    if (center - half > count - 1 || center + half < 0) return false;
-    first[i] = std::max<std::int64_t>(0, center - half);
-    last[i] = std::min<std::int64_t>(count - 1, center + half);
+  for (std::size_t i = 0; i < dims_; ++i)
+    if (!dimension_window(states, i, mean[i], first + i, last + i)) return false;
+  return true;
+}
+
+bool NoiseModel::dimension_window(const Grid& states, std::size_t dim, double mean, std::int64_t* first,
+                                  std::int64_t* last) const {
+  const auto count = static_cast<std::int64_t>(counts_[dim]);
+  if (whole_grid_dims_[dim]) {
+    *first = 0;
+    *last = count - 1;
+    return true;
   }
+  // A non-finite post state carries no mass onto the grid.
+  if (!std::isfinite(mean)) return false;
+  const std::int64_t center = states.nearest(dim, mean);
+  const std::int64_t half = window_half_cells_[dim];
+  if (center - half > count - 1 || center + half < 0) return false;
+  *first = std::max<std::int64_t>(0, center - half);
+  *last = std::min<std::int64_t>(count - 1, center + half);
   return true;
 }
 

@@ -106,6 +106,8 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.compute_units = device_value<cl_uint>(ids[d], CL_DEVICE_MAX_COMPUTE_UNITS);
       info.max_work_group = device_value<std::size_t>(ids[d], CL_DEVICE_MAX_WORK_GROUP_SIZE);
       info.fp64 = device_string(ids[d], CL_DEVICE_EXTENSIONS).find("cl_khr_fp64") != std::string::npos;
+      info.native_double_width = device_value<cl_uint>(ids[d], CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE);
+      info.max_clock_mhz = device_value<cl_uint>(ids[d], CL_DEVICE_MAX_CLOCK_FREQUENCY);
       devices.push_back(info);
     }
   }
@@ -140,27 +142,37 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
   };
   const DeviceInfo* gpu = first_of(true);
   const DeviceInfo* cpu = first_of(false);
-  const DeviceInfo* fallback = cpu ? cpu : &candidates.front();
+  // An explicit kind is honoured or refused, never replaced by another device.
+  auto refuse = [&](const std::string& kind) -> DeviceError {
+    std::string present;
+    for (const DeviceInfo& info : all) present += "\n  " + info.label() + " (" + info.type_name() + ")";
+    return DeviceError("compute.device " + kind + " was requested but no OpenCL " + kind +
+                       " device with double precision matches; devices present:" + present);
+  };
   switch (compute.device) {
     case DeviceKind::Gpu:
-      if (gpu) return *gpu;
-      notes.push_back({NoteSeverity::Warning, NoteKind::DeviceFallback,
-                       "device gpu requested but no OpenCL GPU found; falling back to " + fallback->label()});
-      return *fallback;
+      if (!gpu) throw refuse("gpu");
+      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device gpu: " + gpu->label()});
+      return *gpu;
     case DeviceKind::Cpu:
-      if (cpu) return *cpu;
-      notes.push_back({NoteSeverity::Warning, NoteKind::DeviceFallback,
-                       "device cpu requested but no OpenCL CPU device found; using " + candidates.front().label()});
-      return candidates.front();
-    default:
-      if (gpu) {
-        notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device auto: chose GPU " + gpu->label()});
-        return *gpu;
-      }
-      notes.push_back({NoteSeverity::Warning, NoteKind::DeviceFallback,
-                       "device auto: no OpenCL GPU found, using " + fallback->label()});
-      return *fallback;
+      if (!cpu) throw refuse("cpu");
+      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device cpu: " + cpu->label()});
+      return *cpu;
+    default: {
+      const DeviceInfo& chosen = gpu ? *gpu : cpu ? *cpu : candidates.front();
+      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice,
+                       std::string("device auto: ") + (gpu ? "chose GPU " : "no OpenCL GPU found, using ") +
+                           chosen.label()});
+      return chosen;
+    }
   }
+}
+
+Kernel create_kernel(cl_program program, const char* name) {
+  cl_int error = CL_SUCCESS;
+  Kernel kernel(clCreateKernel(program, name, &error));
+  check(error, (std::string("clCreateKernel(") + name + ")").c_str());
+  return kernel;
 }
 
 std::string selected_device_label(const ComputeConfig& compute) {

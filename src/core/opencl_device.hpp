@@ -43,6 +43,9 @@ using Program = ClHandle<cl_program, clReleaseProgram>;
 using Kernel = ClHandle<cl_kernel, clReleaseKernel>;
 using Buffer = ClHandle<cl_mem, clReleaseMemObject>;
 
+/// The kernel `name` of a built program; DeviceError naming it when it is missing.
+Kernel create_kernel(cl_program program, const char* name);
+
 /// A string property of a platform or a device; "?" when the query fails.
 std::string platform_string(cl_platform_id platform, cl_platform_info what);
 std::string device_string(cl_device_id device, cl_device_info what);
@@ -57,6 +60,8 @@ struct DeviceInfo {
   cl_uint compute_units = 0;
   std::size_t max_work_group = 1;
   bool fp64 = false;
+  cl_uint native_double_width = 1;  ///< CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE: 1 on SIMT GPUs
+  cl_uint max_clock_mhz = 0;        ///< CL_DEVICE_MAX_CLOCK_FREQUENCY
   bool is_gpu() const { return (type & CL_DEVICE_TYPE_GPU) != 0; }
   bool is_cpu() const { return (type & CL_DEVICE_TYPE_CPU) != 0; }
   std::string label() const { return platform_name + " / " + device_name; }

@@ -3,10 +3,13 @@
 #include "opencl_engine.hpp"
 
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "amytiss/errors.hpp"
+#include "device_peak.hpp"
+#include "factored_program.hpp"
 #include "opencl_device.hpp"
 #include "opencl_layout.hpp"
 #include "opencl_program_cache.hpp"
@@ -19,37 +22,59 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+// The factored sweep runs where it does at most this share of the dense sweep's multiply-adds:
+// its stage tensors cost memory traffic and index arithmetic that the dense records do not.
+constexpr double kFactoredShareLimit = 0.5;
+
 // What the OpenCL engine cannot run, found before any device work.
-void check_supported(const Abstraction& a, const Layout& layout) {
+void check_supported(const Abstraction& a) {
   if (!a.noise->separable())
     throw ConfigError("noise.covariance",
                       "a full (non-diagonal) covariance is supported by device: reference only; "
                       "use a diagonal covariance (n values, example: covariance: [0.75, 0.75]) or "
                       "compute.device: reference");
-  if (a.states.size() >= (std::size_t(1) << 32) || layout.padded_size >= (std::size_t(1) << 32))
+  if (a.states.size() >= (std::size_t(1) << 32))
     throw ConfigError("states", "the OpenCL engine supports fewer than 2^32 state cells (got " +
                                     std::to_string(a.states.size()) + ")");
 }
 
-Kernel create_kernel(cl_program program, const char* name) {
-  cl_int error = CL_SUCCESS;
-  Kernel kernel(clCreateKernel(program, name, &error));
-  check(error, (std::string("clCreateKernel(") + name + ")").c_str());
-  return kernel;
+// The dense sweep's padded value array is indexed with 32 bits.
+void check_dense_supported(const Layout& layout) {
+  if (layout.padded_size >= (std::size_t(1) << 32))
+    throw ConfigError("states", "the dense sweep supports fewer than 2^32 padded value cells (got " +
+                                    std::to_string(layout.padded_size) + "); narrow the noise window "
+                                    "(noise.truncation) or use dynamics expressions, whose factored sweep "
+                                    "has no padding");
 }
 
-// The policy before the sweep: grids, roles, provenance, V_{T_d} and room for every step.
-Policy empty_policy(const Abstraction& a, const std::string& device_label) {
-  Policy policy;
-  policy.states = a.states;
-  policy.inputs = a.inputs;
-  policy.horizon = a.horizon;
-  policy.roles = a.roles;
-  policy.computed_by = device_label;
-  policy.config_hash = config_hash(a.config);
-  policy.values.assign((std::size_t(a.horizon) + 1) * a.states.size(), 0.0);
-  policy.input_index.assign(std::size_t(a.horizon) * a.states.size(), 0);
-  return policy;
+// The factored plan when the decomposition asks for it or it saves enough work; a Sweep note
+// says which sweep runs and why.
+std::optional<FactoredPlan> choose_factored(const Abstraction& a, const DeviceInfo& device,
+                                            const SynthesisOptions& options, SynthesisReport& rep) {
+  const SweepChoice decomposition = options.compute.sweep;
+  if (decomposition == SweepChoice::Dense) {
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, "dense sweep (requested)"});
+    return std::nullopt;
+  }
+  std::string reason;
+  const double budget = options.compute.memory_fraction * double(device.global_memory);
+  std::optional<FactoredPlan> plan = plan_factored_sweep(a, budget, double(device.max_allocation), &reason);
+  if (decomposition == SweepChoice::Factored) {
+    if (!plan) throw DeviceError("the factored sweep was requested but cannot run: " + reason);
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, plan->describe() + " (requested)"});
+    return plan;
+  }
+  if (!plan) {
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, "dense sweep: the factored sweep cannot run: " + reason});
+    return std::nullopt;
+  }
+  if (plan->multiply_adds > kFactoredShareLimit * plan->dense_multiply_adds) {
+    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                         "dense sweep: the factored sweep would save too little (" + plan->describe() + ")"});
+    return std::nullopt;
+  }
+  rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, plan->describe()});
+  return plan;
 }
 
 // Step `step` of the policy's values from a padded value array.
@@ -66,11 +91,15 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   SynthesisReport local_report;
   SynthesisReport& rep = report ? *report : local_report;
   const Layout layout(a);
-  check_supported(a, layout);
+  check_supported(a);
 
   auto phase_start = Clock::now();
   const DeviceInfo device = choose_device(options.compute, rep.notes);
   rep.device = device.label();
+  const DevicePeak peak = double_fma_peak(device.is_gpu(), device.is_cpu(), device.label(), device.compute_units,
+                                          device.max_clock_mhz, device.native_double_width);
+  rep.peak_multiply_adds_per_second = peak.multiply_adds_per_second;
+  rep.peak_basis = peak.basis;
   DeviceSession session = open_session(device);
   rep.phases.push_back({"device setup", seconds_since(phase_start), 0, 0});
 
@@ -79,6 +108,17 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
       throw Cancelled();
   };
 
+  if (const auto factored = choose_factored(a, device, options, rep)) {
+    rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
+    FactoredRunContext run{&device,          session.context.get(),
+                           session.queue.get(), engine_options.kernel_cache_dir,
+                           engine_options.factored_entry_per_item, options.profile,
+                           report_progress};
+    Policy policy = run_factored_sweep(a, *factored, run, rep);
+    rep.host_peak_bytes = peak_resident_bytes();
+    return policy;
+  }
+  check_dense_supported(layout);
   const RunPlan plan = plan_run(a, layout, device, options, engine_options, rep);
 
   phase_start = Clock::now();
@@ -107,6 +147,11 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   std::vector<double> step_values(layout.padded_size);
   const double multiply_adds_per_step =
       double(buffers.free_states) * double(plan.records_per_state) * contraction_multiply_adds(a);
+  // Each multiply-add loads a double of V; stored records are streamed once per step; each state
+  // stores its value and input.
+  const double record_bytes_per_step =
+      plan.on_the_fly ? 0.0 : double(buffers.free_states) * double(plan.records_per_state) * double(layout.record_bytes());
+  const double bytes_per_step = 8.0 * multiply_adds_per_step + record_bytes_per_step + 12.0 * double(a.states.size());
   const auto synthesis_start = Clock::now();
   int current = 0;
   for (unsigned step = a.horizon; step-- > 0;) {
@@ -117,7 +162,7 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
     const double seconds = seconds_since(phase_start);
     unpad(policy, step, buffers.padded_index, step_values.data());
     rep.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
-                          multiply_adds_per_step});
+                          multiply_adds_per_step, bytes_per_step});
     const unsigned done = a.horizon - step;
     const double remaining = seconds_since(synthesis_start) / done * (a.horizon - done);
     report_progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done, remaining);

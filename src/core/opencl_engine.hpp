@@ -21,12 +21,14 @@ enum class SweepVariant {
 };
 
 struct OpenClEngineOptions {
-  SweepVariant variant = SweepVariant::Auto;
+  SweepVariant variant = SweepVariant::Auto;  ///< of the dense sweep (compute.sweep chooses the sweep)
   /// Upper bound of states per chunk (stored buffers and launches); 0: chosen from device limits.
   std::size_t max_states_per_chunk = 0;
   /// Folder of the program binary cache; empty: $XDG_CACHE_HOME/amytiss/kernels or
   /// ~/.cache/amytiss/kernels; "-": no cache (always build from source).
   std::string kernel_cache_dir;
+  /// Factored sweep: one entry per work-item (the GPU shape) even on a SIMD device (tests).
+  bool factored_entry_per_item = false;
 };
 
 /// The OpenCL engine (device chosen by options.compute, see synthesize()).

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
 
 namespace amytiss::detail {
@@ -27,6 +28,19 @@ void set_argument(cl_kernel kernel, cl_uint index, std::size_t size, const void*
 }
 
 }  // namespace
+
+Policy empty_policy(const Abstraction& a, const std::string& device_label) {
+  Policy policy;
+  policy.states = a.states;
+  policy.inputs = a.inputs;
+  policy.horizon = a.horizon;
+  policy.roles = a.roles;
+  policy.computed_by = device_label;
+  policy.config_hash = config_hash(a.config);
+  policy.values.assign((std::size_t(a.horizon) + 1) * a.states.size(), 0.0);
+  policy.input_index.assign(std::size_t(a.horizon) * a.states.size(), 0);
+  return policy;
+}
 
 DeviceSession open_session(const DeviceInfo& device) {
   cl_int error = CL_SUCCESS;
@@ -63,18 +77,19 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
       rep.transitions = "on_the_fly (requested; " + estimate + ")";
       break;
     case TransitionStorage::Stored:
-      plan.on_the_fly = !fits;
-      rep.transitions = fits ? "stored (requested; " + estimate + ")"
-                             : "on_the_fly (stored requested but does not fit: " + estimate + ")";
+      // An explicit request is honoured or refused, never silently replaced.
+      if (!fits)
+        throw DeviceError("compute.transitions stored was requested but the records do not fit on " +
+                          device.label() + ": " + estimate +
+                          "; use transitions: auto or on_the_fly, or a larger compute.memory_fraction");
+      rep.transitions = "stored (requested; " + estimate + ")";
       break;
     default:
       plan.on_the_fly = !fits;
       rep.transitions = (fits ? "stored (auto: " : "on_the_fly (auto: ") + estimate + ")";
       break;
   }
-  const bool storage_differs = options.compute.transitions == TransitionStorage::Stored && !fits;
-  rep.notes.push_back({storage_differs ? NoteSeverity::Warning : NoteSeverity::Info, NoteKind::Transitions,
-                       "transitions: " + rep.transitions});
+  rep.notes.push_back({NoteSeverity::Info, NoteKind::Transitions, "transitions: " + rep.transitions});
 
   plan.variant = engine_options.variant;
   if (plan.variant == SweepVariant::Auto)

@@ -13,6 +13,10 @@
 
 namespace amytiss::detail {
 
+/// The policy before the sweep: grids, roles, provenance (device label, configuration hash), and
+/// zeroed values and inputs for every step.
+Policy empty_policy(const Abstraction& abstraction, const std::string& device_label);
+
 /// A context and an in-order command queue on one device.
 struct DeviceSession {
   Context context;

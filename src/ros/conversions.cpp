@@ -141,6 +141,23 @@ visualization_msgs::Marker outline(const PlaneBox& box, const std::string& frame
 
 }  // namespace
 
+visualization_msgs::Marker make_car_marker(const std::vector<double>& state, const amytiss::VehicleOutline& outline,
+                                           const std::string& frame_id) {
+  constexpr double kCarHeight = 1.4;  // m, for the picture only
+  visualization_msgs::Marker marker = colored_marker(frame_id, "car", visualization_msgs::Marker::CUBE, 0.1f, 0.3f, 0.9f, 0.8f);
+  const double yaw = state.at(outline.yaw_index);
+  const double ahead = 0.5 * outline.length - outline.rear_to_reference;
+  marker.pose.position.x = state.at(outline.x_index) + ahead * std::cos(yaw);
+  marker.pose.position.y = state.at(outline.y_index) + ahead * std::sin(yaw);
+  marker.pose.position.z = 0.5 * kCarHeight;
+  marker.pose.orientation.z = std::sin(0.5 * yaw);
+  marker.pose.orientation.w = std::cos(0.5 * yaw);
+  marker.scale.x = outline.length;
+  marker.scale.y = outline.width;
+  marker.scale.z = kCarHeight;
+  return marker;
+}
+
 visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config, const std::string& frame_id) {
   visualization_msgs::MarkerArray markers;
   const amytiss::Grid states(config.states);

@@ -11,6 +11,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
+#include "amytiss/model.hpp"
 #include "amytiss/policy.hpp"
 
 namespace amytiss_ros {
@@ -42,5 +43,12 @@ std::string describe_progress(const amytiss::Progress& progress);
 /// in `frame_id`.
 visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config,
                                                  const std::string& frame_id);
+
+/// RViz marker of a car's body at `state` (configuration order, state units): a blue box of the
+/// outline's length x width x 1.4 m, centred (length/2 - rear_to_reference) ahead of the
+/// reference point (state[x_index], state[y_index]) along the yaw state[yaw_index] (rad), in
+/// `frame_id` (m), namespace "car", id 0, so each new state replaces the last.
+visualization_msgs::Marker make_car_marker(const std::vector<double>& state, const amytiss::VehicleOutline& outline,
+                                           const std::string& frame_id);
 
 }  // namespace amytiss_ros

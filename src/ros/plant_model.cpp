@@ -1,6 +1,7 @@
 #include "plant_model.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "amytiss/noise.hpp"
@@ -62,6 +63,33 @@ StateClass classify_state(const amytiss::Policy& policy, const std::vector<doubl
     case amytiss::CellRole::FixedZero: return StateClass::Unsafe;
     default: return StateClass::Free;
   }
+}
+
+std::optional<amytiss::VehicleOutline> vehicle_outline(const amytiss::Config& config) {
+  for (const auto& model : amytiss::builtin_models())
+    if (model.name == config.model) return model.outline;
+  return std::nullopt;
+}
+
+std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const std::vector<double>& first,
+                                const std::vector<double>& last) {
+  constexpr double kDegreesPerRadian = 180.0 / M_PI;
+  char text[160];
+  std::snprintf(text, sizeof text, " (yaw changed by %.1f degrees, moved %.2f m along x and %.2f m along y)",
+                (last.at(outline.yaw_index) - first.at(outline.yaw_index)) * kDegreesPerRadian,
+                last.at(outline.x_index) - first.at(outline.x_index), last.at(outline.y_index) - first.at(outline.y_index));
+  return text;
+}
+
+std::string consistency_text(unsigned successes, unsigned episodes, double predicted) {
+  constexpr double kStandardErrors = 4.0;
+  const double rate = episodes ? double(successes) / episodes : 0.0;
+  const double bound = episodes ? kStandardErrors * std::sqrt(predicted * (1 - predicted) / episodes) : 0.0;
+  const double difference = std::abs(rate - predicted);
+  char text[200];
+  std::snprintf(text, sizeof text, "|rate - V_0| = %.4f, 4 standard errors of V_0 over %u episodes = %.4f: %s",
+                difference, episodes, bound, difference <= bound ? "consistent" : "NOT consistent");
+  return text;
 }
 
 EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step) {

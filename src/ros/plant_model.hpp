@@ -5,6 +5,7 @@
 // (the synthesis assumed the worst case, so a random one can only do better).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -42,6 +43,18 @@ struct EpisodeOutcome {
   bool success = false;
   std::string description;  ///< "reached the target at step 12", "entered the avoid set at step 3", ...
 };
+/// The body of the configuration's vehicle (a built-in model of a car), or nothing.
+std::optional<amytiss::VehicleOutline> vehicle_outline(const amytiss::Config& config);
+/// " (yaw changed by 90.2 degrees, moved 5.9 m along x and -7.6 m along y)": how a vehicle's
+/// episode from `first` to `last` (states) turned and moved, appended to its outcome.
+std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const std::vector<double>& first,
+                                const std::vector<double>& last);
+
+/// "|rate - V_0| = 0.0014, 4 standard errors of V_0 over 20 episodes = 0.0334: consistent" (or
+/// "NOT consistent"): the empirical success rate against the prediction, with the binomial
+/// standard error sqrt(V_0 (1 - V_0) / episodes) of a rate whose true value is V_0.
+std::string consistency_text(unsigned successes, unsigned episodes, double predicted);
+
 /// Outcome of an episode that ended at `step` in a state of class `state_class` (for Free: the
 /// horizon is over). Reach specs succeed on Target; safety succeeds when the horizon is over.
 EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step);

@@ -13,9 +13,11 @@
 #include <sstream>
 
 #include <amytiss_msgs/StateStamped.h>
+#include <visualization_msgs/Marker.h>
 
 #include "amytiss/policy_file.hpp"
 #include "config_from_params.hpp"
+#include "conversions.hpp"
 #include "plant_model.hpp"
 #include "synthesizer.hpp"
 
@@ -25,6 +27,7 @@ PlantSimulatorNode::PlantSimulatorNode(ros::NodeHandle public_handle, ros::NodeH
     : public_handle_(public_handle), private_handle_(private_handle) {
   state_publisher_ = public_handle_.advertise<amytiss_msgs::StateStamped>("state", 10);
   summary_publisher_ = public_handle_.advertise<amytiss_msgs::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
+  car_publisher_ = public_handle_.advertise<visualization_msgs::Marker>("car_marker", 10);
   status_subscriber_ = public_handle_.subscribe("status", 10, &PlantSimulatorNode::on_status, this);
   command_subscriber_ = public_handle_.subscribe("command", 10, &PlantSimulatorNode::on_command, this,
                                                  ros::TransportHints().tcpNoDelay());
@@ -104,6 +107,10 @@ int PlantSimulatorNode::run() {
   // The interpreter catkin was configured with (the one catkin_install_python puts in shebangs).
   private_handle_.param<std::string>("python", python, AMYTISS_PYTHON_EXECUTABLE);
   private_handle_.param("exit_when_done", exit_when_done, true);
+  std::string scene_file;
+  double playback_period_s = 0.0;
+  private_handle_.param<std::string>("scene_file", scene_file, "");
+  private_handle_.param("playback_period_s", playback_period_s, 0.0);
   if (output_dir.empty())
     output_dir = std::filesystem::path(default_policy_path("x")).parent_path().string() + "/episodes";
 
@@ -135,6 +142,7 @@ int PlantSimulatorNode::run() {
     return 1;
   }
   PlantModel plant(config, static_cast<std::uint64_t>(seed));
+  const std::optional<amytiss::VehicleOutline> outline = vehicle_outline(config);
   std::vector<double> predicted_input(policy.inputs.dims());
   double predicted = 0.0;
   if (policy.lookup(initial_state.data(), initial_state.size(), 0, predicted_input.data(), &predicted) !=
@@ -173,6 +181,7 @@ int PlantSimulatorNode::run() {
     EpisodeOutcome outcome;
     unsigned step = 0;
     for (;; ++step) {
+      if (outline) car_publisher_.publish(make_car_marker(state, *outline, "map"));
       const StateClass state_class = classify_state(policy, state);
       if (state_class != StateClass::Free || step >= policy.horizon) {
         outcome = episode_outcome(config.spec.type, state_class, step);
@@ -217,7 +226,9 @@ int PlantSimulatorNode::run() {
       }
       rows.push_back(csv_row(episode, step, state, command->input, policy.inputs.dims(), command->probability));
       state = plant.step(state, command->input);
+      if (playback_period_s > 0) ros::WallDuration(playback_period_s).sleep();
     }
+    if (outline) outcome.description += vehicle_motion_text(*outline, initial_state, state);
     summary.episodes += 1;
     if (outcome.success) summary.successes += 1;
     const std::string line = "episode " + std::to_string(episode) + ": " + outcome.description;
@@ -234,13 +245,24 @@ int PlantSimulatorNode::run() {
   ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); predicted V_0 at the "
            "start state = %.4f",
            summary.successes, summary.episodes, summary.success_rate, standard_error, predicted);
+  ROS_INFO("plant simulator: %s", consistency_text(summary.successes, summary.episodes, predicted).c_str());
 
   if (!plot_script.empty()) {
     summary.trajectories_png = base + "_trajectories.png";
     summary.values_png = base + "_values.png";
-    const std::string failure =
-        run_program({python, plot_script, "--csv", csv_path, "--policy", status->policy_file, "--initial-state",
-                     join(initial_state), "--trajectories", summary.trajectories_png, "--values", summary.values_png});
+    std::vector<std::string> arguments = {python, plot_script, "--csv", csv_path, "--policy", status->policy_file,
+                                          "--initial-state", join(initial_state), "--trajectories",
+                                          summary.trajectories_png, "--values", summary.values_png};
+    if (outline) {
+      arguments.push_back("--footprint");
+      arguments.push_back(join({outline->length, outline->width, outline->rear_to_reference,
+                                double(outline->x_index), double(outline->y_index), double(outline->yaw_index)}));
+    }
+    if (!scene_file.empty()) {
+      arguments.push_back("--scene");
+      arguments.push_back(scene_file);
+    }
+    const std::string failure = run_program(arguments);
     if (failure.empty()) {
       ROS_INFO("pictures: %s and %s", summary.trajectories_png.c_str(), summary.values_png.c_str());
     } else {

@@ -11,7 +11,12 @@
 // Private parameters: initial_state (list, state units, required), episodes (int, 20), seed
 // (int, 1), output_dir (string, default $ROS_HOME/amytiss/episodes), plot_script (string, empty:
 // no pictures), python (string, default: the Python catkin was configured with), command_timeout_s (5), policy_timeout_s
-// (600), exit_when_done (bool, true).
+// (600), exit_when_done (bool, true), scene_file (string, empty: none; a picture's scene for the
+// plot script, e.g. config/bmw_parking_scene.yaml), playback_period_s (wall seconds between steps,
+// 0: as fast as the loop runs; for watching in RViz).
+// For a built-in model of a car (amytiss::VehicleOutline) it also publishes the body on car_marker
+// (visualization_msgs/Marker, frame "map") at every state, tells each outcome how the car turned
+// and moved, and has its footprint drawn in the trajectory picture.
 #include <condition_variable>
 #include <mutex>
 #include <string>
@@ -36,7 +41,7 @@ class PlantSimulatorNode {
   void on_command(const amytiss_msgs::InputCommand::ConstPtr& command);
 
   ros::NodeHandle public_handle_, private_handle_;
-  ros::Publisher state_publisher_, summary_publisher_;
+  ros::Publisher state_publisher_, summary_publisher_, car_publisher_;
   ros::Subscriber status_subscriber_, command_subscriber_;
 
   std::mutex mutex_;

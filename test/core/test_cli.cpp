@@ -161,6 +161,15 @@ TEST_F(CliTest, MissingConfigurationFileExitsTwo) {
   EXPECT_CONTAINS(result.err, "absent.yaml");
 }
 
+TEST_F(CliTest, AnAbsentDeviceKindExitsOneNamingTheDevices) {
+  const CommandResult devices = synth("--list-devices");
+  if (devices.out.find("(GPU") != std::string::npos) GTEST_SKIP() << "a GPU is present";
+  const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device gpu --quiet");
+  EXPECT_EQ(1, result.exit_code);
+  EXPECT_CONTAINS(result.err, "compute.device gpu was requested");
+  EXPECT_CONTAINS(result.err, "devices present");
+}
+
 TEST_F(CliTest, BadOptionsExitTwo) {
   CommandResult result = synth("--config " + quote(kTinyConfig) + " --device tpu");
   EXPECT_EQ(2, result.exit_code);

@@ -198,7 +198,7 @@ TEST(Config, DynamicsErrors) {
   root = base();
   root.remove("dynamics");
   root["model"] = "tesla";
-  expect_error(root, "model", "got 'tesla', expected one of bmw320i, vehicle3d");
+  expect_error(root, "model", "got 'tesla', expected one of bmw320i, bmw320i_ks, vehicle3d");
 
   root = base();
   root.remove("dynamics");

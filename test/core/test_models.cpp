@@ -49,12 +49,15 @@ std::vector<double> apply(const Dynamics& dynamics, const std::vector<double>& x
 
 TEST(Models, BuiltinList) {
   const auto& models = builtin_models();
-  ASSERT_EQ(models.size(), 2u);
+  ASSERT_EQ(models.size(), 3u);
   EXPECT_EQ(models[0].name, "bmw320i");
   EXPECT_EQ(models[0].state_dims, 7u);
   EXPECT_EQ(models[0].input_dims, 2u);
-  EXPECT_EQ(models[1].name, "vehicle3d");
-  EXPECT_EQ(models[1].state_dims, 3u);
+  EXPECT_EQ(models[1].name, "bmw320i_ks");
+  EXPECT_EQ(models[1].state_dims, 5u);
+  EXPECT_EQ(models[1].input_dims, 2u);
+  EXPECT_EQ(models[2].name, "vehicle3d");
+  EXPECT_EQ(models[2].state_dims, 3u);
 }
 
 TEST(Models, Vehicle3dHandValues) {
@@ -204,6 +207,12 @@ TEST(Models, OpenclSourceCompilesAsCAndAgrees) {
   cases.push_back({make_dynamics(config_with("bmw320i", 7, 2)), {1, 2, 0.1, 1.5, 0.3, 0.1, 0.01}, {0.2, 1.0}});
   cases.push_back({make_dynamics(config_with("bmw320i", 7, 2)), {1, 2, 0.1, 0.05, 0.3, 0.1, 0.01}, {0.2, 1.0}});
   cases.push_back({make_dynamics(config_with("vehicle3d", 3, 2)), {1, 2, 0.5}, {2, 0.3}});
+  Config kinematic = config_with("bmw320i_ks", 5, 2);
+  kinematic.integrator = IntegratorConfig{IntegrationMethod::Rk4, 3, 0.5};
+  cases.push_back({make_dynamics(kinematic), {1, 2, 0.3, 1.2, 0.4}, {-0.3, 0.5}});
+  Config oscillator = config_with(R"(["x1", "-x0 + u0"])", 2, 1);
+  oscillator.integrator = IntegratorConfig{IntegrationMethod::Euler, 4, 0.25};
+  cases.push_back({make_dynamics(oscillator), {1, 0.5}, {0.2}});
   cases.push_back({make_dynamics(load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/room_temperature_5d.yaml")),
                    {19.5, 20, 20.5, 21, 19}, {0.4, 1}});
   const std::string dir = ::testing::TempDir();

@@ -19,6 +19,7 @@
 #include "amytiss/errors.hpp"
 #include "opencl_engine.hpp"
 #include "opencl_source.hpp"
+#include "agreement.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -38,66 +39,6 @@ Abstraction from_yaml(const std::string& text) {
   return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
 }
 
-// Expected next value of (state, input) under V_{step+1} of `policy`, min over disturbances,
-// evaluated directly in double from the noise model (independent of both engines' loops).
-double input_value(const Abstraction& a, const Policy& policy, unsigned step, std::size_t state,
-                   std::size_t input) {
-  const std::size_t dims = a.states.dims();
-  const std::vector<double> x = a.states.point(state), u = a.inputs.point(input);
-  const double* next = &policy.values[std::size_t(step + 1) * a.states.size()];
-  double worst = std::numeric_limits<double>::infinity();
-  for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
-    const std::vector<double> disturbance = a.disturbances.point(w);
-    std::vector<double> mean(dims);
-    a.dynamics->evaluate(x.data(), u.data(), disturbance.data(), mean.data());
-    std::vector<std::int64_t> first(dims), last(dims);
-    double expected = 0.0;
-    if (a.noise->window(a.states, mean.data(), first.data(), last.data())) {
-      std::vector<std::size_t> multi(dims);
-      for (std::size_t d = 0; d < dims; ++d) multi[d] = std::size_t(first[d]);
-      while (true) {
-        double probability = 1.0;
-        for (std::size_t d = 0; d < dims; ++d)
-          probability *= a.noise->cell_mass(d, multi[d], mean[d], a.noise->scale(d, x.data()));
-        expected += probability * next[a.states.flat_index(multi.data())];
-        std::size_t d = dims;
-        while (d-- > 0) {
-          if (std::int64_t(++multi[d]) <= last[d]) break;
-          multi[d] = std::size_t(first[d]);
-        }
-        if (d == std::size_t(-1)) break;
-      }
-    }
-    worst = std::min(worst, expected);
-  }
-  return worst;
-}
-
-struct Agreement {
-  double max_value_difference = 0;
-  std::size_t input_mismatches = 0;       // cells whose chosen inputs differ
-  double max_mismatch_margin = 0;         // largest q(reference input) - q(opencl input) there
-};
-
-Agreement compare(const Abstraction& a, const Policy& reference, const Policy& opencl) {
-  Agreement result;
-  EXPECT_EQ(reference.values.size(), opencl.values.size());
-  EXPECT_EQ(reference.input_index.size(), opencl.input_index.size());
-  for (std::size_t i = 0; i < reference.values.size(); ++i)
-    result.max_value_difference =
-        std::max(result.max_value_difference, std::fabs(reference.values[i] - opencl.values[i]));
-  for (unsigned step = 0; step < a.horizon; ++step)
-    for (std::size_t cell = 0; cell < a.states.size(); ++cell) {
-      const auto chosen_reference = reference.input(step, cell), chosen_opencl = opencl.input(step, cell);
-      if (chosen_reference == chosen_opencl) continue;
-      ++result.input_mismatches;
-      const double margin = input_value(a, reference, step, cell, chosen_reference) -
-                            input_value(a, reference, step, cell, chosen_opencl);
-      result.max_mismatch_margin = std::max(result.max_mismatch_margin, margin);
-    }
-  return result;
-}
-
 SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::Auto) {
   SynthesisOptions options;
   options.compute.device = DeviceKind::Cpu;
@@ -105,35 +46,47 @@ SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::
   return options;
 }
 
+// The dense sweep whatever the dynamics (the engine's choice may be the factored sweep).
+SynthesisOptions dense_options(TransitionStorage transitions = TransitionStorage::Auto) {
+  SynthesisOptions options = cpu_options(transitions);
+  options.compute.sweep = SweepChoice::Dense;
+  return options;
+}
+
 double seconds_of(const SynthesisReport& report) {
   double total = 0;
   for (const auto& phase : report.phases)
-    if (phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
+    if (!phase.breakdown && phase.name != "device setup" && phase.name != "kernel build") total += phase.seconds;
   return total;
 }
 
-// Runs both engines, checks the contract, prints the figures.
+// Runs the reference, the dense sweep and the engine's own choice (the factored sweep where the
+// dynamics allow it), checks the contract for both, prints the figures.
 void expect_agreement(const std::string& label, const Abstraction& a,
                       TransitionStorage transitions = TransitionStorage::Auto) {
   const auto reference_start = std::chrono::steady_clock::now();
   const Policy reference = synthesize_reference(a, {}, nullptr);
   const double reference_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - reference_start).count();
-  SynthesisReport report;
-  const Policy opencl = synthesize(a, cpu_options(transitions), &report);
-  const Agreement agreement = compare(a, reference, opencl);
-  std::printf("[%s] pairs %zu, max |dV| %.3g, input mismatches %zu (max margin %.3g), reference %.3f s, "
-              "opencl %.3f s (%s)\n",
-              label.c_str(), a.pairs(), agreement.max_value_difference, agreement.input_mismatches,
-              agreement.max_mismatch_margin, reference_seconds, seconds_of(report),
-              report.transitions.c_str());
-  EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label;
-  EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
-  // Values are probabilities: the policy file refuses anything outside [0, 1].
-  for (double value : opencl.values) {
-    ASSERT_GE(value, 0.0) << label;
-    ASSERT_LE(value, 1.0) << label;
-  }
+  SynthesisReport dense_report, auto_report;
+  const Policy dense_policy = detail::synthesize_opencl(a, dense_options(transitions), &dense_report);
+  const Policy chosen = synthesize(a, cpu_options(transitions), &auto_report);
+  auto check = [&](const char* name, const Policy& opencl, const SynthesisReport& report) {
+    const Agreement agreement = compare(a, reference, opencl);
+    std::printf("[%s, %s] pairs %zu, max |dV| %.3g, input mismatches %zu (max margin %.3g), reference %.3f s, "
+                "opencl %.3f s (%s)\n",
+                label.c_str(), name, a.pairs(), agreement.max_value_difference, agreement.input_mismatches,
+                agreement.max_mismatch_margin, reference_seconds, seconds_of(report), report.transitions.c_str());
+    EXPECT_LE(agreement.max_value_difference, kValueTolerance) << label << ", " << name;
+    EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label << ", " << name;
+    // Values are probabilities: the policy file refuses anything outside [0, 1].
+    for (double value : opencl.values) {
+      ASSERT_GE(value, 0.0) << label;
+      ASSERT_LE(value, 1.0) << label;
+    }
+  };
+  check("dense", dense_policy, dense_report);
+  check("auto", chosen, auto_report);
 }
 
 std::string robot_reach_avoid_yaml(double state_eta, double input_eta, unsigned horizon) {
@@ -349,8 +302,8 @@ TEST(OpenClEngine, StochyFourteenDimensionsIsTheOneDimensionalValueToThe14th) {
 TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
   const Abstraction a = from_yaml(robot_safety_yaml(1.0, 0.4, 4));
   SynthesisReport stored_report;
-  const Policy stored = detail::synthesize_opencl(a, cpu_options(TransitionStorage::Stored), &stored_report,
-                                                  {SweepVariant::ItemPerState, 0, {}});
+  const Policy stored = detail::synthesize_opencl(a, dense_options(TransitionStorage::Stored), &stored_report,
+                                                  {SweepVariant::ItemPerState, 0, {}, false});
   EXPECT_EQ(stored_report.transitions.rfind("stored", 0), 0u) << stored_report.transitions;
   struct Variant {
     const char* name;
@@ -358,15 +311,15 @@ TEST(OpenClEngine, StoredOnTheFlyGroupAndChunkedRunsAreIdentical) {
     OpenClEngineOptions engine;
   };
   const Variant variants[] = {
-      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}}},
-      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}}},
-      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}}},
-      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}}},
-      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}}},
+      {"on the fly, item", TransitionStorage::OnTheFly, {SweepVariant::ItemPerState, 0, {}, false}},
+      {"stored, group (GPU path)", TransitionStorage::Stored, {SweepVariant::GroupPerState, 0, {}, false}},
+      {"on the fly, group (GPU path)", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 0, {}, false}},
+      {"stored, item, chunks of 37 states", TransitionStorage::Stored, {SweepVariant::ItemPerState, 37, {}, false}},
+      {"on the fly, group, chunks of 50 states", TransitionStorage::OnTheFly, {SweepVariant::GroupPerState, 50, {}, false}},
   };
   for (const Variant& variant : variants) {
     SynthesisReport report;
-    const Policy other = detail::synthesize_opencl(a, cpu_options(variant.transitions), &report, variant.engine);
+    const Policy other = detail::synthesize_opencl(a, dense_options(variant.transitions), &report, variant.engine);
     EXPECT_EQ(other.values, stored.values) << variant.name;
     EXPECT_EQ(other.input_index, stored.input_index) << variant.name;
     const bool group = variant.engine.variant == SweepVariant::GroupPerState;
@@ -387,25 +340,41 @@ TEST(OpenClEngine, AutoTransitionsFallsBackToOnTheFlyWhenStoredDoesNotFit) {
   SynthesisOptions options = cpu_options(TransitionStorage::Auto);
   options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
   SynthesisReport report;
-  const Policy small_budget = synthesize(a, options, &report);
+  options.compute.sweep = SweepChoice::Dense;
+  const Policy small_budget = detail::synthesize_opencl(a, options, &report);
   EXPECT_EQ(report.transitions.rfind("on_the_fly (auto", 0), 0u) << report.transitions;
   SynthesisReport stored_report;
-  const Policy stored = synthesize(a, cpu_options(TransitionStorage::Auto), &stored_report);
+  const Policy stored = detail::synthesize_opencl(a, dense_options(TransitionStorage::Auto), &stored_report);
   EXPECT_EQ(stored_report.transitions.rfind("stored (auto", 0), 0u) << stored_report.transitions;
   EXPECT_EQ(small_budget.values, stored.values);
+}
+
+TEST(OpenClEngine, StoredRequestThatDoesNotFitIsRefusedNotReplaced) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
+  SynthesisOptions options = dense_options(TransitionStorage::Stored);
+  options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
+  try {
+    detail::synthesize_opencl(a, options, nullptr);
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    EXPECT_NE(std::string(error.what()).find("compute.transitions stored was requested"), std::string::npos)
+        << error.what();
+  }
+  // Not retried elsewhere either: the request is the user's.
+  EXPECT_THROW(synthesize(a, options), DeviceError);
 }
 
 TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 3));
   std::vector<Progress> seen;
-  SynthesisOptions options = cpu_options(TransitionStorage::Stored);
+  SynthesisOptions options = dense_options(TransitionStorage::Stored);
   options.profile = true;
   options.progress = [&](const Progress& progress) {
     seen.push_back(progress);
     return true;
   };
   SynthesisReport report;
-  const Policy policy = synthesize(a, options, &report);
+  const Policy policy = detail::synthesize_opencl(a, options, &report);
   std::vector<std::string> names;
   for (const auto& phase : report.phases) names.push_back(phase.name);
   const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0"};
@@ -451,22 +420,28 @@ TEST(OpenClEngine, FullCovarianceIsRefusedClearly) {
   }
 }
 
-TEST(OpenClEngine, GpuRequestWithoutGpuFallsBackWithWarning) {
+TEST(OpenClEngine, ExplicitRequestForAnAbsentDeviceKindFailsNamingTheDevicesPresent) {
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
-  const bool has_gpu = [] {
-    for (const auto& line : list_opencl_devices())
-      if (line.find("(GPU") != std::string::npos) return true;
-    return false;
-  }();
-  if (has_gpu) GTEST_SKIP() << "a GPU is present; the fallback cannot be observed";
+  const auto devices = list_opencl_devices();
+  auto present = [&](const char* type) {
+    return std::any_of(devices.begin(), devices.end(),
+                       [&](const std::string& line) { return line.find(std::string("(") + type) != std::string::npos; });
+  };
+  // CI has only pocl (no GPU); the GPU machine has no CPU device.
+  if (present("GPU") && present("CPU")) GTEST_SKIP() << "both kinds present: no absent kind to request";
+  const bool ask_gpu = !present("GPU");
   SynthesisOptions options = cpu_options();
-  options.compute.device = DeviceKind::Gpu;
-  SynthesisReport report;
-  synthesize(a, options, &report);
-  EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(), [](const EngineNote& note) {
-    return note.severity == NoteSeverity::Warning && note.kind == NoteKind::DeviceFallback &&
-           note.text.find("no OpenCL GPU") != std::string::npos;
-  }));
+  options.compute.device = ask_gpu ? DeviceKind::Gpu : DeviceKind::Cpu;
+  try {
+    synthesize(a, options);
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(std::string("compute.device ") + (ask_gpu ? "gpu" : "cpu") + " was requested"),
+              std::string::npos) << message;
+    EXPECT_NE(message.find("devices present"), std::string::npos) << message;
+    EXPECT_NE(message.find(devices.front().substr(devices.front().find("] ") + 2, 20)), std::string::npos) << message;
+  }
 }
 
 TEST(OpenClEngine, UnknownDeviceSelectionIsADeviceError) {

@@ -1,7 +1,9 @@
-// rostest: closed-loop episodes through the topics; the success rate is consistent with V_0.
+// rostest: closed-loop episodes of a steering car through the topics; the success rate is
+// consistent with V_0 and every successful episode turned the car.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 #include <mutex>
 
 #include <amytiss_msgs/EpisodeSummary.h>
@@ -16,8 +18,10 @@ constexpr double kStandardErrors = 4.0;
 // The plant is the concrete system, the guarantee is for the abstraction (nearest-cell snapping):
 // allow this much below V_0 beyond the sampling error.
 constexpr double kAbstractionGap = 0.05;
+// The target's yaw is 80-100 degrees from the start's 0.
+constexpr double kMinimumTurnDegrees = 45.0;
 
-TEST(ClosedLoop, MostEpisodesReachTheTargetConsistentWithV0) {
+TEST(ClosedLoop, SteeringCarReachesTheTargetConsistentWithV0) {
   ros::NodeHandle handle;
   std::mutex mutex;
   amytiss_msgs::EpisodeSummary::ConstPtr summary;
@@ -42,13 +46,20 @@ TEST(ClosedLoop, MostEpisodesReachTheTargetConsistentWithV0) {
   const double predicted = summary->predicted_probability;
   EXPECT_GT(predicted, 0.5);
   const double standard_error = std::sqrt(std::max(predicted * (1 - predicted), 0.25 / kEpisodes) / kEpisodes);
-  EXPECT_GE(summary->success_rate, predicted - kStandardErrors * standard_error - kAbstractionGap)
+  EXPECT_NEAR(summary->success_rate, predicted, kStandardErrors * standard_error + kAbstractionGap)
       << "successes " << summary->successes << "/" << summary->episodes << ", V_0 " << predicted;
+  // Outcomes of a car end with " (yaw changed by D degrees, ...)".
+  for (const std::string& outcome : summary->outcomes) {
+    if (outcome.find("reached the target") == std::string::npos) continue;
+    const std::size_t at = outcome.find("yaw changed by ");
+    ASSERT_NE(at, std::string::npos) << outcome;
+    EXPECT_GE(std::stod(outcome.substr(at + std::string("yaw changed by ").size())), kMinimumTurnDegrees) << outcome;
+  }
   std::ifstream csv(summary->csv_file);
   ASSERT_TRUE(csv.good()) << summary->csv_file;
   std::string header;
   std::getline(csv, header);
-  EXPECT_EQ(header, "episode,step,x0,x1,u0,u1,probability,success");
+  EXPECT_EQ(header, "episode,step,x0,x1,x2,x3,x4,u0,u1,probability,success");
 }
 
 }  // namespace

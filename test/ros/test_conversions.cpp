@@ -276,6 +276,35 @@ TEST(Markers, GridBoundsTargetAndAvoid) {
   EXPECT_EQ(markers.markers[2].header.frame_id, "map");
 }
 
+TEST(Markers, CarBodyFollowsTheState) {
+  constexpr double kTolerance = 1e-12;
+  // The kinematic BMW: reference point at the rear axle, 0.965 m ahead of the rear bumper.
+  const auto outline = amytiss_ros::vehicle_outline(
+      amytiss::load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/bmw_parking.yaml"));
+  ASSERT_TRUE(outline.has_value());
+  EXPECT_EQ(outline->yaw_index, 4u);
+  const double yaw = M_PI / 2;  // nose along +y: the body's centre is 4.508/2 - 0.965 ahead in y
+  const visualization_msgs::Marker marker = amytiss_ros::make_car_marker({1.0, -2.0, 0.3, -0.5, yaw}, *outline, "map");
+  EXPECT_EQ(marker.ns, "car");
+  EXPECT_EQ(marker.id, 0);
+  EXPECT_EQ(marker.type, visualization_msgs::Marker::CUBE);
+  EXPECT_EQ(marker.header.frame_id, "map");
+  EXPECT_NEAR(marker.pose.position.x, 1.0, kTolerance);
+  EXPECT_NEAR(marker.pose.position.y, -2.0 + 4.508 / 2 - 0.965, kTolerance);
+  EXPECT_NEAR(marker.pose.orientation.z, std::sin(yaw / 2), kTolerance);
+  EXPECT_NEAR(marker.pose.orientation.w, std::cos(yaw / 2), kTolerance);
+  EXPECT_DOUBLE_EQ(marker.scale.x, 4.508);
+  EXPECT_DOUBLE_EQ(marker.scale.y, 1.61);
+  // Yaw 0: the centre moves along +x.
+  const auto ahead = amytiss_ros::make_car_marker({1.0, -2.0, 0.0, 0.0, 0.0}, *outline, "map");
+  EXPECT_NEAR(ahead.pose.position.x, 1.0 + 4.508 / 2 - 0.965, kTolerance);
+  EXPECT_NEAR(ahead.pose.position.y, -2.0, kTolerance);
+  // A model that is not a car has no outline.
+  EXPECT_FALSE(amytiss_ros::vehicle_outline(amytiss::load_config_file(kTinyConfig)).has_value());
+  EXPECT_EQ(amytiss_ros::vehicle_motion_text(*outline, {5.5, 4.25, 0, 0, 0}, {0.0, -3.5, 0, 0, M_PI / 2}),
+            " (yaw changed by 90.0 degrees, moved -5.50 m along x and -7.75 m along y)");
+}
+
 TEST(PlantModel, SameSeedSameTrajectoryAndNoiseHasTheConfiguredCovariance) {
   const amytiss::Config config = amytiss::load_config_file(kTinyConfig);
   amytiss_ros::PlantModel first(config, 7), second(config, 7), other(config, 8);
@@ -310,6 +339,14 @@ TEST(Outcomes, TextsPerSpecification) {
             "left the grid at step 5");
   EXPECT_FALSE(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Free, 14).success);
   EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Free, 8).success);
+}
+
+TEST(Outcomes, ConsistencyOfTheRateWithV0) {
+  // V_0 0.9986 over 20 episodes: standard error sqrt(0.9986 * 0.0014 / 20) = 0.00836.
+  EXPECT_EQ(amytiss_ros::consistency_text(20, 20, 0.9986),
+            "|rate - V_0| = 0.0014, 4 standard errors of V_0 over 20 episodes = 0.0334: consistent");
+  EXPECT_EQ(amytiss_ros::consistency_text(15, 20, 0.9986),
+            "|rate - V_0| = 0.2486, 4 standard errors of V_0 over 20 episodes = 0.0334: NOT consistent");
 }
 
 TEST(Outcomes, ClassifyByCellRole) {

@@ -1,6 +1,7 @@
 /* The 7-d single-track (ST) model of a BMW 320i with tire slip, AMYTISS (CAV 2020) section 7,
- * from Althoff et al., "CommonRoad: Vehicle Models", section 5.1. Explicit Euler step, tau = 0.1 s.
- * Valid as C++ and as OpenCL C (double precision); noise is not part of f.
+ * from Althoff et al., "CommonRoad: Vehicle Models", section 5.1: the continuous-time vector field;
+ * the integrator (integrator.h) steps it, by default one explicit Euler step of BMW320I_TAU = 0.1 s
+ * (the paper's). Valid as C++ and as OpenCL C (double precision); noise is not part of g.
  *
  * State (the paper's x1..x7 are x[0]..x[6]):
  *   x[0], x[1]  position [m]          x[2]  steering angle [rad]     x[3]  heading velocity [m/s]
@@ -9,9 +10,7 @@
  *
  * Below |x[3]| < 0.1 m/s the kinematic branch (a_i of the paper) is used, above it the dynamic
  * one (b_i). Inputs pass through CommonRoad's steeringConstraints / accelerationConstraints
- * (Sat1, Sat2) with the limits of CommonRoad vehicle 2 (parameters_vehicle2, BMW 320i):
- *   steering angle [-1.066, 1.066] rad, steering velocity [-0.4, 0.4] rad/s,
- *   velocity [-13.6, 50.8] m/s, switching velocity 7.319 m/s, |acceleration| <= 11.5 m/s^2.
+ * (Sat1, Sat2) with the limits of CommonRoad vehicle 2 (commonroad_vehicle2.h, BMW 320i).
  * The paper's vehicle parameters are used for the dynamics (l_wb 2.5789, m 1093.3, mu 1.0489,
  * l_f 1.156, l_r 1.422, h_cg 0.6137, I_z 1791.6, C_Sf = C_Sr = 20.89, g = 9.81).
  * The saturated inputs are used everywhere, as in CommonRoad. The slip-angle term of b7 follows
@@ -20,7 +19,7 @@
 #ifndef AMYTISS_MODEL_BMW320I_H
 #define AMYTISS_MODEL_BMW320I_H
 
-/* AMYTISS_MODEL_FUNCTION comes from model_function.h, which is put before this header. */
+/* model_function.h and commonroad_vehicle2.h are put before this header. */
 
 #define BMW320I_TAU 0.1
 #define BMW320I_KINEMATIC_SPEED 0.1
@@ -34,41 +33,11 @@
 #define BMW320I_C_SF 20.89
 #define BMW320I_C_SR 20.89
 #define BMW320I_G 9.81
-#define BMW320I_STEERING_MIN (-1.066)
-#define BMW320I_STEERING_MAX 1.066
-#define BMW320I_STEERING_V_MIN (-0.4)
-#define BMW320I_STEERING_V_MAX 0.4
-#define BMW320I_V_MIN (-13.6)
-#define BMW320I_V_MAX 50.8
-#define BMW320I_V_SWITCH 7.319
-#define BMW320I_A_MAX 11.5
 
-/* Sat1: CommonRoad steeringConstraints. */
-AMYTISS_MODEL_FUNCTION double amytiss_bmw320i_sat_steering(double steering_angle, double steering_velocity) {
-  if ((steering_angle <= BMW320I_STEERING_MIN && steering_velocity <= 0.0) ||
-      (steering_angle >= BMW320I_STEERING_MAX && steering_velocity >= 0.0))
-    return 0.0;
-  if (steering_velocity <= BMW320I_STEERING_V_MIN) return BMW320I_STEERING_V_MIN;
-  if (steering_velocity >= BMW320I_STEERING_V_MAX) return BMW320I_STEERING_V_MAX;
-  return steering_velocity;
-}
-
-/* Sat2: CommonRoad accelerationConstraints. */
-AMYTISS_MODEL_FUNCTION double amytiss_bmw320i_sat_acceleration(double velocity, double acceleration) {
-  double positive_limit = BMW320I_A_MAX;
-  if (velocity > BMW320I_V_SWITCH) positive_limit = BMW320I_A_MAX * BMW320I_V_SWITCH / velocity;
-  if ((velocity <= BMW320I_V_MIN && acceleration <= 0.0) || (velocity >= BMW320I_V_MAX && acceleration >= 0.0))
-    return 0.0;
-  if (acceleration <= -BMW320I_A_MAX) return -BMW320I_A_MAX;
-  if (acceleration >= positive_limit) return positive_limit;
-  return acceleration;
-}
-
-AMYTISS_MODEL_FUNCTION void amytiss_model_bmw320i(const double* x, const double* u, const double* w, double* post) {
+AMYTISS_MODEL_FUNCTION void amytiss_rate_bmw320i(const double* x, const double* u, const double* w, double* rate) {
   (void)w;
-  const double steering_velocity = amytiss_bmw320i_sat_steering(x[2], u[0]);
-  const double acceleration = amytiss_bmw320i_sat_acceleration(x[3], u[1]);
-  double rate[7];
+  const double steering_velocity = amytiss_vehicle2_sat_steering(x[2], u[0]);
+  const double acceleration = amytiss_vehicle2_sat_acceleration(x[3], u[1]);
   rate[2] = steering_velocity;
   rate[3] = acceleration;
   if (fabs(x[3]) < BMW320I_KINEMATIC_SPEED) {
@@ -95,7 +64,6 @@ AMYTISS_MODEL_FUNCTION void amytiss_model_bmw320i(const double* x, const double*
                    (BMW320I_L_R * rear - BMW320I_L_F * front) * x[5] / x[3]) -
               x[5];
   }
-  for (int i = 0; i < 7; ++i) post[i] = x[i] + BMW320I_TAU * rate[i];
 }
 
 #endif

@@ -3,8 +3,9 @@
  * vehicle example. Continuous time:
  *   dx0/dt = u0 cos(alpha + x2) / cos(alpha),  dx1/dt = u0 sin(alpha + x2) / cos(alpha),
  *   dx2/dt = u0 tan(u1),                       alpha = atan(tan(u1) / 2),
- * discretized here with one explicit Euler step of tau = 0.3 s (the sampling period of that
- * example in SCOTS and pFaces). Valid as C++ and as OpenCL C (double precision).
+ * the continuous-time vector field; the integrator (integrator.h) steps it, by default one explicit
+ * Euler step of VEHICLE3D_TAU = 0.3 s (the sampling period of that example in SCOTS and pFaces).
+ * Valid as C++ and as OpenCL C (double precision).
  * State: x[0], x[1] position [m], x[2] heading [rad]. Input: u[0] speed [m/s], u[1] steering
  * angle [rad]. No disturbance; noise is not part of f. */
 #ifndef AMYTISS_MODEL_VEHICLE3D_H
@@ -14,12 +15,12 @@
 
 #define VEHICLE3D_TAU 0.3
 
-AMYTISS_MODEL_FUNCTION void amytiss_model_vehicle3d(const double* x, const double* u, const double* w, double* post) {
+AMYTISS_MODEL_FUNCTION void amytiss_rate_vehicle3d(const double* x, const double* u, const double* w, double* rate) {
   (void)w;
   const double alpha = atan(tan(u[1]) / 2.0);
-  post[0] = x[0] + VEHICLE3D_TAU * u[0] * cos(alpha + x[2]) / cos(alpha);
-  post[1] = x[1] + VEHICLE3D_TAU * u[0] * sin(alpha + x[2]) / cos(alpha);
-  post[2] = x[2] + VEHICLE3D_TAU * u[0] * tan(u[1]);
+  rate[0] = u[0] * cos(alpha + x[2]) / cos(alpha);
+  rate[1] = u[0] * sin(alpha + x[2]) / cos(alpha);
+  rate[2] = u[0] * tan(u[1]);
 }
 
 #endif

@@ -1,0 +1,294 @@
+// The factored sweep: its plan (dependencies, order, slices), its mass tables, and its results
+// against the reference engine and the dense sweep, sliced and unsliced, on pocl.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "factored_plan.hpp"
+#include "factored_tables.hpp"
+#include "opencl_device.hpp"
+#include "opencl_engine.hpp"
+#include "agreement.hpp"
+#include "test_support.hpp"
+
+namespace amytiss {
+namespace {
+
+using detail::FactoredPlan;
+
+// Both engines sum the same exact products in another order: double rounding only.
+constexpr double kValueTolerance = 1e-9;
+// The dense sweep stores masses as float (docs/engine.md's bound); the product asks for 1e-5.
+constexpr double kDenseTolerance = 1e-5;
+constexpr double kMassTolerance = 1e-15;
+// A chosen input may differ from the reference's only where the two are valued this close.
+constexpr double kInputMarginTolerance = 1e-12;
+constexpr double kUnlimitedBudget = 1e12;
+
+Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+
+// The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
+std::string traffic_yaml(double eta, unsigned horizon) {
+  const std::string e = std::to_string(eta);
+  return "name: traffic_small\n"
+         "states: {lb: [0, 0, 0], ub: [8, 8, 8], eta: [" + e + ", " + e + ", " + e + "]}\n"
+         "inputs: {lb: [0, 0], ub: [1, 1], eta: [1, 1]}\n"
+         "constants: {flow: 0.36, q: 0.5, entry1: 6.0, entry3: 8.0}\n"
+         "dynamics: [\"(1 - flow)*x0 + flow*x2 + entry1*u0\", \"(1 - flow - q)*x1 + flow*x0\",\n"
+         "           \"(1 - flow)*x2 + flow*x1 + entry3*u1\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.7, 0.7, 0.7],\n"
+         "        truncation: cutting_probability, cutting_probability: 2.0e-2}\n"
+         "spec: {type: safety, horizon: " + std::to_string(horizon) + "}\n";
+}
+
+std::string robot_disturbance_yaml() {
+  return "name: robot_small\n"
+         "states: {lb: [-10, -10], ub: [10, 10], eta: [1, 1]}\n"
+         "inputs: {lb: [-1, -1], ub: [1, 1], eta: [0.4, 0.4]}\n"
+         "disturbances: {lb: [-1], ub: [1], eta: [0.5]}\n"
+         "constants: {tau: 10.0}\n"
+         "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+         "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
+}
+
+std::string multiplicative_yaml() {
+  return "name: multiplicative_small\n"
+         "states: {lb: [-2, -2, -1], ub: [2, 2, 1], eta: [0.25, 0.25, 0.5]}\n"
+         "inputs: {lb: [-1], ub: [1], eta: [0.5]}\n"
+         "dynamics: [\"0.8*x0 + 0.3*u0\", \"0.5*x1 + 0.2*x0*u0\", \"0.9*x2\"]\n"
+         "noise: {type: multiplicative, distribution: normal, covariance: [0.04, 0.01, 0.02],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+         "spec: {type: safety, horizon: 5, safe: {lb: [-1.5, -1.5, -1], ub: [1.5, 1.5, 1]}}\n";
+}
+
+SynthesisOptions cpu_options() {
+  SynthesisOptions options;
+  options.compute.device = DeviceKind::Cpu;
+  return options;
+}
+
+Policy run(const Abstraction& a, SweepChoice sweep, SynthesisReport* report = nullptr, double memory_fraction = 0.5) {
+  SynthesisOptions options = cpu_options();
+  options.compute.memory_fraction = memory_fraction;
+  options.compute.sweep = sweep;
+  SynthesisReport local;
+  return detail::synthesize_opencl(a, options, report ? report : &local);
+}
+
+double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double largest = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) largest = std::max(largest, std::fabs(a[i] - b[i]));
+  return largest;
+}
+
+bool has_note(const SynthesisReport& report, const std::string& fragment) {
+  return std::any_of(report.notes.begin(), report.notes.end(),
+                     [&](const EngineNote& note) { return note.text.find(fragment) != std::string::npos; });
+}
+
+TEST(FactoredPlan, TrafficReadsTwoStatesAndOneInputPerCoordinate) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  // Variables: x0 x1 x2 u0 u1 = 0..4.
+  EXPECT_EQ(plan->reads[0], (std::vector<std::size_t>{0, 2, 3}));
+  EXPECT_EQ(plan->reads[1], (std::vector<std::size_t>{0, 1}));
+  EXPECT_EQ(plan->reads[2], (std::vector<std::size_t>{1, 2, 4}));
+  EXPECT_EQ(plan->slices, 1u);
+  EXPECT_EQ(plan->q_size, a.pairs());
+  // Wide windows and few inputs: variable elimination must save most of the work.
+  EXPECT_LT(plan->multiply_adds * 5, plan->dense_multiply_adds) << plan->describe();
+}
+
+TEST(FactoredPlan, SlicesWhenTheTensorsDoNotFitAndRefusesWhatCannotFit) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
+  std::string reason;
+  const auto whole = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(whole) << reason;
+  const double sliced_budget = double(whole->device_bytes) * 0.6;
+  const auto sliced = detail::plan_factored_sweep(a, sliced_budget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(sliced) << reason;
+  EXPECT_GT(sliced->slices, 1u);
+  EXPECT_LE(double(sliced->device_bytes), sliced_budget);
+  EXPECT_EQ(a.states.count(sliced->order.back()) % sliced->slices, 0u);
+  EXPECT_DOUBLE_EQ(sliced->multiply_adds, whole->multiply_adds);
+  EXPECT_FALSE(detail::plan_factored_sweep(a, 1000.0, kUnlimitedBudget, &reason));
+  EXPECT_NE(reason.find("budget"), std::string::npos) << reason;
+}
+
+TEST(FactoredPlan, DynamicsWithoutDependenciesAreRefusedWithTheReason) {
+  using namespace test_support;
+  const Abstraction a = random_affine_abstraction(3, 2, 1, false, safety_spec(2));
+  std::string reason;
+  EXPECT_FALSE(detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason));
+  EXPECT_NE(reason.find("do not say which components"), std::string::npos) << reason;
+}
+
+TEST(FactoredPlan, MultiplicativeNoiseReadsTheCoordinateItScales) {
+  const Abstraction a = from_yaml(multiplicative_yaml());
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  EXPECT_EQ(plan->reads[1], (std::vector<std::size_t>{0, 1, 3}));  // x0, u0 by f; x1 by the scale
+  EXPECT_EQ(plan->reads[2], (std::vector<std::size_t>{2}));
+}
+
+TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
+  const Abstraction a = from_yaml(robot_disturbance_yaml());
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  const auto tables = detail::factored_mass_tables(a, *plan);
+  // Every (x, u, w) triple: each dimension's row at its tuple equals the window masses.
+  std::vector<double> post(2);
+  std::vector<std::int64_t> first(2), last(2);
+  std::size_t checked = 0;
+  for (std::size_t x = 0; x < a.states.size(); x += 7)
+    for (std::size_t u = 0; u < a.inputs.size(); u += 3)
+      for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
+        const auto xs = a.states.point(x), us = a.inputs.point(u), ws = a.disturbances.point(w);
+        a.dynamics->evaluate(xs.data(), us.data(), ws.data(), post.data());
+        std::vector<std::size_t> xm(2), um(2), wm(1);
+        a.states.multi_index(x, xm.data());
+        a.inputs.multi_index(u, um.data());
+        a.disturbances.multi_index(w, wm.data());
+        const std::size_t digits[] = {xm[0], xm[1], um[0], um[1], wm[0]};
+        for (std::size_t dim = 0; dim < 2; ++dim) {
+          const detail::MassTable& table = tables[dim];
+          std::size_t tuple = 0;
+          for (std::size_t v : table.variables) tuple = tuple * plan->variables[v].count + digits[v];
+          std::int64_t lo = 0, hi = -1;
+          const bool kept = a.noise->dimension_window(a.states, dim, post[dim], &lo, &hi);
+          ASSERT_EQ(table.count[tuple], kept ? std::uint32_t(hi - lo + 1) : 0u);
+          if (!kept) continue;
+          ASSERT_EQ(table.first[tuple], std::uint32_t(lo));
+          for (std::int64_t k = lo; k <= hi; ++k) {
+            const double expected = a.noise->cell_mass(dim, std::size_t(k), post[dim], a.noise->scale(dim, xs.data()));
+            EXPECT_NEAR(table.masses[tuple * table.width + std::size_t(k - lo)], expected, kMassTolerance);
+          }
+          ++checked;
+        }
+      }
+  EXPECT_GT(checked, 100u);
+}
+
+void expect_factored_agrees(const std::string& label, const Abstraction& a) {
+  const Policy reference = synthesize_reference(a, {}, nullptr);
+  SynthesisReport factored_report, dense_report;
+  const Policy factored = run(a, SweepChoice::Factored, &factored_report);
+  const Policy dense = run(a, SweepChoice::Dense, &dense_report);
+  EXPECT_TRUE(has_note(factored_report, "factored sweep")) << label;
+  EXPECT_FALSE(has_note(dense_report, "factored sweep: eliminates")) << label;
+  const double against_reference = max_difference(reference.values, factored.values);
+  const double against_dense = max_difference(dense.values, factored.values);
+  std::printf("[%s] pairs %zu: factored vs reference max |dV| %.3g, vs dense %.3g\n", label.c_str(), a.pairs(),
+              against_reference, against_dense);
+  EXPECT_LE(against_reference, kValueTolerance) << label;
+  EXPECT_LE(against_dense, kDenseTolerance) << label;
+  // Inputs: the reference's wherever it does not value both choices equally (ties within rounding).
+  const test_support::Agreement agreement = test_support::compare(a, reference, factored);
+  EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
+  for (double value : factored.values) {
+    ASSERT_GE(value, 0.0) << label;
+    ASSERT_LE(value, 1.0) << label;
+  }
+}
+
+TEST(FactoredSweep, TrafficFewInputsWideWindowAgreesWithReferenceAndDense) {
+  expect_factored_agrees("traffic 3-d eta 0.4", from_yaml(traffic_yaml(0.4, 4)));
+}
+
+TEST(FactoredSweep, RobotWithDisturbanceAgreesWithReferenceAndDense) {
+  expect_factored_agrees("robot reach-avoid with disturbance", from_yaml(robot_disturbance_yaml()));
+}
+
+TEST(FactoredSweep, MultiplicativeNoiseAgreesWithReferenceAndDense) {
+  expect_factored_agrees("multiplicative 3-d", from_yaml(multiplicative_yaml()));
+}
+
+TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
+  for (const std::string& yaml : {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml()}) {
+    const Abstraction a = from_yaml(yaml);
+    SynthesisOptions options = cpu_options();
+    options.compute.sweep = SweepChoice::Factored;
+    SynthesisReport rows_report, entries_report;
+    const Policy rows = detail::synthesize_opencl(a, options, &rows_report);
+    detail::OpenClEngineOptions entries_engine;
+    entries_engine.factored_entry_per_item = true;
+    const Policy entries = detail::synthesize_opencl(a, options, &entries_report, entries_engine);
+    EXPECT_TRUE(has_note(rows_report, "a row of entries per work-item"));
+    EXPECT_TRUE(has_note(entries_report, "one entry per work-item"));
+    EXPECT_EQ(rows.values, entries.values) << a.config.name;
+    EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name;
+  }
+}
+
+TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 3));
+  SynthesisReport whole_report, sliced_report;
+  const Policy whole = run(a, SweepChoice::Factored, &whole_report);
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  // A memory fraction that leaves room for a third of the stage tensors forces slices.
+  std::vector<EngineNote> notes;
+  const double global_memory = double(detail::choose_device(cpu_options().compute, notes).global_memory);
+  ASSERT_GT(global_memory, 0.0);
+  const Policy sliced = run(a, SweepChoice::Factored, &sliced_report,
+                            (double(plan->device_bytes) * 0.6) / global_memory);
+  EXPECT_TRUE(has_note(sliced_report, "slices")) << "expected a sliced plan";
+  EXPECT_LE(max_difference(whole.values, sliced.values), kValueTolerance);
+  EXPECT_EQ(whole.input_index, sliced.input_index);
+}
+
+TEST(FactoredSweep, AutoChoosesFactoredWhereItSavesWorkAndDenseOtherwise) {
+  SynthesisReport traffic_report, lambda_report;
+  run(from_yaml(traffic_yaml(0.4, 1)), SweepChoice::Auto, &traffic_report);
+  EXPECT_TRUE(has_note(traffic_report, "factored sweep: eliminates"));
+  using namespace test_support;
+  run(random_affine_abstraction(5, 2, 1, false, safety_spec(2)), SweepChoice::Auto, &lambda_report);
+  EXPECT_TRUE(has_note(lambda_report, "dense sweep"));
+  EXPECT_TRUE(has_note(lambda_report, "do not say which components"));
+}
+
+TEST(FactoredSweep, ReportsPhasesStagesAndProgress) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
+  SynthesisOptions options = cpu_options();
+  options.profile = true;
+  std::vector<Phase> seen;
+  options.progress = [&](const Progress& progress) {
+    seen.push_back(progress.phase);
+    return true;
+  };
+  options.compute.sweep = SweepChoice::Factored;
+  SynthesisReport report;
+  detail::synthesize_opencl(a, options, &report);
+  std::vector<std::string> names;
+  double stage_multiply_adds = 0, step_multiply_adds = 0;
+  for (const auto& phase : report.phases) {
+    names.push_back(phase.name);
+    if (phase.name.rfind("stage", 0) == 0) stage_multiply_adds += phase.multiply_adds;
+    if (phase.name.rfind("step", 0) == 0) step_multiply_adds += phase.multiply_adds;
+  }
+  ASSERT_GE(names.size(), 9u);
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 5),
+            (std::vector<std::string>{"device setup", "kernel build", "construction", "step 1", "step 0"}));
+  EXPECT_EQ(names[5].rfind("stage 0 (x'", 0), 0u) << names[5];
+  // The stages' multiply-adds over all steps are the steps' multiply-adds.
+  EXPECT_GT(step_multiply_adds, 0);
+  EXPECT_NEAR(stage_multiply_adds, step_multiply_adds, 1e-9 * step_multiply_adds);
+  EXPECT_EQ(seen, (std::vector<Phase>{Phase::Setup, Phase::Construction, Phase::Synthesis, Phase::Done}));
+}
+
+}  // namespace
+}  // namespace amytiss
