@@ -23,13 +23,19 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   // Requests keep being answered, successfully, during the whole re-synthesis and swap.
   std::atomic<bool> stop{false};
   std::atomic<int> answered{0}, failed{0};
+  std::string first_failure;  // written by the caller thread only, read after join()
   std::thread caller([&] {
     ros::ServiceClient client = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input");
     while (!stop) {
       amytiss_msgs::GetInput service;
       service.request.state = {-4.0, -4.0};
       service.request.time_step = 0;
-      if (client.call(service) && service.response.success) ++answered; else ++failed;
+      const bool called = client.call(service);
+      if (called && service.response.success) {
+        ++answered;
+      } else if (++failed == 1) {
+        first_failure = called ? service.response.message : "the service call itself failed";
+      }
     }
   });
 
@@ -65,7 +71,7 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
 
   stop = true;
   caller.join();
-  EXPECT_EQ(failed.load(), 0);
+  EXPECT_EQ(failed.load(), 0) << "first failure: " << first_failure;
   EXPECT_GT(answered.load(), 0);
 
   // Unchanged parameters: the file is reused, nothing is computed.
