@@ -28,9 +28,26 @@ target_compile_definitions(amytiss_core PUBLIC CL_TARGET_OPENCL_VERSION=120)
 target_link_libraries(amytiss_core PUBLIC Eigen3::Eigen OpenCL::OpenCL yaml-cpp ${HDF5_LIBRARIES} Threads::Threads)
 set_target_properties(amytiss_core PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
+# MPI (optional): amytiss_synth runs under mpirun, its ranks splitting one synthesis
+# (docs/scale_out.md). The core does not link MPI; the CLI passes it a Communicator.
+find_package(MPI COMPONENTS C QUIET)
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/amytiss_synth.cpp)
-  add_executable(amytiss_synth src/cli/amytiss_synth.cpp)
+  add_executable(amytiss_synth src/cli/amytiss_synth.cpp src/cli/mpi_session.cpp)
   target_link_libraries(amytiss_synth amytiss_core)
+  if(MPI_C_FOUND)
+    # OMPI_SKIP_MPICXX: the C API only (the deprecated C++ bindings need libmpi_cxx).
+    target_compile_definitions(amytiss_synth PRIVATE AMYTISS_WITH_MPI OMPI_SKIP_MPICXX MPICH_SKIP_MPICXX)
+    target_link_libraries(amytiss_synth MPI::MPI_C)
+    message(STATUS "amytiss: MPI found (${MPIEXEC_EXECUTABLE}): amytiss_synth runs under mpirun")
+  else()
+    message(STATUS "amytiss: MPI not found: amytiss_synth runs as one process")
+  endif()
+endif()
+# What the CLI tests need to know about MPI: the launcher, when the CLI was built with MPI.
+if(MPI_C_FOUND)
+  set(AMYTISS_TEST_MPIEXEC "${MPIEXEC_EXECUTABLE}")
+else()
+  set(AMYTISS_TEST_MPIEXEC "")
 endif()
 
 if(AMYTISS_WITH_ROS)
@@ -69,12 +86,14 @@ if(AMYTISS_CORE_TESTS)
       target_include_directories(amytiss_test_${test_name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core)
       target_compile_definitions(amytiss_test_${test_name} PRIVATE
         AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
-        AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>")
+        AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>"
+        AMYTISS_MPIEXEC="${AMYTISS_TEST_MPIEXEC}")
     endforeach()
   endif()
   target_link_libraries(amytiss_core_tests amytiss_core)
   target_include_directories(amytiss_core_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core)
   target_compile_definitions(amytiss_core_tests PRIVATE
     AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
-    AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>")
+    AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>"
+    AMYTISS_MPIEXEC="${AMYTISS_TEST_MPIEXEC}")
 endif()

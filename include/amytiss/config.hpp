@@ -83,7 +83,25 @@ struct ComputeConfig {
   std::string device_name;
   /// Fraction of the device's reported global memory the engine may use, in (0, 1].
   double memory_fraction = 0.5;
+  /// Several devices working on one synthesis (docs/scale_out.md): empty, the one device above;
+  /// ["all"], every OpenCL device with double precision; else a list of DeviceSelector texts
+  /// ("gpu:0", "gpu:1", "cpu:0", "0.1", "cpu:0/1"). platform / device_name / device then do not apply.
+  std::vector<std::string> devices;
 };
+
+/// One entry of compute.devices: "gpu:N" / "cpu:N" is the N-th (0-based) GPU / CPU device with
+/// double precision; "P.D" is device D of platform P as `amytiss_synth --list-devices` numbers
+/// them. A suffix "/C" splits that device into sub-devices of C compute units each
+/// (clCreateSubDevices, equally), each of which works as a device of its own.
+struct DeviceSelector {
+  enum class Kind { Gpu, Cpu, Index };
+  Kind kind = Kind::Gpu;
+  std::size_t platform = 0;       ///< Index only
+  std::size_t index = 0;          ///< among the devices of that kind (Gpu, Cpu) or of the platform
+  unsigned units_per_part = 0;    ///< 0: the whole device
+};
+/// The selector a compute.devices entry names, or nullopt when the text is not one.
+std::optional<DeviceSelector> parse_device_selector(const std::string& text);
 
 struct Config {
   std::string name;

@@ -7,6 +7,7 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
+#include "amytiss/scale_out.hpp"
 
 namespace amytiss {
 
@@ -72,12 +73,20 @@ struct SynthesisReport {
   std::string peak_basis;
   std::size_t host_peak_bytes = 0;    ///< peak resident set of the process (VmHWM)
   std::vector<EngineNote> notes;      ///< device choice and fallback, storage, chunking, ...
+  /// Several devices or ranks (docs/scale_out.md): seconds spent exchanging the parts between
+  /// them (device read-backs, MPI, writes back), and the bytes one time step exchanges (every
+  /// part of every exchanged array once). 0 for one device.
+  double exchange_seconds = 0;
+  double exchange_bytes_per_step = 0;
 };
 
 struct SynthesisOptions {
   ComputeConfig compute;              ///< device, transitions, selection, memory fraction
   ProgressCallback progress;          ///< may be empty
   bool profile = false;               ///< finish each kernel before timing (slower, exact phases)
+  /// The ranks of an MPI run (docs/scale_out.md); null: this process alone. With several ranks
+  /// or compute.devices, the OpenCL engine splits the work and every rank returns the whole policy.
+  Communicator* communicator = nullptr;
 };
 
 /// Runs the engine named by options.compute.device. `auto` prefers a GPU, else the CPU OpenCL
@@ -87,6 +96,11 @@ struct SynthesisOptions {
 /// ConfigError.
 Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
                   SynthesisReport* report = nullptr);
+
+/// The work split of a synthesis over several devices or ranks (compute.devices, communicator),
+/// without computing: the sweep, each device's part and memory, the exchange per time step; one
+/// line each (amytiss_synth --dry-run). Collective over the communicator's ranks.
+std::vector<std::string> describe_scale_out(const Abstraction& abstraction, const SynthesisOptions& options);
 
 /// Memory a synthesis needs, in bytes, as the OpenCL engine lays it out (docs/engine.md).
 struct MemoryEstimate {

@@ -13,6 +13,9 @@ std::string format_number(double value);
 /// point nor an exponent ("10" -> "10.0"). Reads back to the same double.
 std::string c_double_literal(double value);
 
+/// Bytes for people: "512 B", "3.2 KiB", "1.5 MiB", "2.0 GiB" (binary units, one decimal).
+std::string format_bytes(double bytes);
+
 /// FNV-1a 64-bit offset basis (the standard start of the hash).
 constexpr std::uint64_t kFnvOffsetBasis = 14695981039346656037ull;
 /// FNV-1a 64-bit hash of the bytes of `text`, started from `basis`.

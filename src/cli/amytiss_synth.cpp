@@ -14,8 +14,10 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/enum_names.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/format.hpp"
 #include "amytiss/policy.hpp"
 #include "amytiss/policy_file.hpp"
+#include "mpi_session.hpp"
 
 namespace {
 
@@ -34,12 +36,17 @@ constexpr const char* kUsage =
     "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
     "  --sweep auto|dense|factored        overrides compute.sweep (docs/engine.md)\n"
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
+    "  --devices all|LIST                 overrides compute.devices: several devices, comma-separated\n"
+    "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
+    "  --dry-run                          print the work split over devices and ranks, compute nothing\n"
     "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
     "  --profile                          per-phase timing, rates and memory table\n"
     "  --compare-reference                also run the serial reference engine and compare V_0\n"
     "  --list-devices                     list the OpenCL devices and exit\n"
     "  --quiet                            no progress lines\n"
     "  --help                             this text\n"
+    "\n"
+    "Under mpirun (a build with MPI) the ranks split the synthesis; rank 0 prints and writes the file.\n"
     "\n"
     "exit status: 0 success, 2 bad input (configuration or options), 1 other failures\n";
 
@@ -55,7 +62,9 @@ struct Options {
   std::string transitions;  // empty: the configuration's
   std::string sweep;        // empty: the configuration's
   std::string platform;
+  std::string devices;      // empty: the configuration's
   std::string output;
+  bool dry_run = false;
   bool profile = false;
   bool compare_reference = false;
   bool list_devices = false;
@@ -77,6 +86,8 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--transitions") options.transitions = value();
     else if (arg == "--sweep") options.sweep = value();
     else if (arg == "--platform") options.platform = value();
+    else if (arg == "--devices") options.devices = value();
+    else if (arg == "--dry-run") options.dry_run = true;
     else if (arg == "--output" || arg == "-o") options.output = value();
     else if (arg == "--profile") options.profile = true;
     else if (arg == "--compare-reference") options.compare_reference = true;
@@ -98,18 +109,6 @@ Enum parse_enum_option(const std::string& option, const std::string& text) {
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string format_bytes(double bytes) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-  std::size_t unit = 0;
-  while (bytes >= 1024.0 && unit + 1 < std::size(units)) {
-    bytes /= 1024.0;
-    ++unit;
-  }
-  char text[64];
-  std::snprintf(text, sizeof text, unit == 0 ? "%.0f %s" : "%.1f %s", bytes, units[unit]);
-  return text;
 }
 
 std::string format_seconds(double seconds) {
@@ -244,7 +243,27 @@ void compare_with_reference(const Abstraction& abstraction, const Policy& policy
   std::printf("  max |dV_0| (engine - reference): %.3g\n", max_difference);
 }
 
-int run(const Options& options) {
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream stream(text);
+  for (std::string item; std::getline(stream, item, ',');) items.push_back(item);
+  return items;
+}
+
+// Each rank's synthesis time and the share of it spent exchanging parts (rank 0 prints).
+void print_rank_times(double synthesis_seconds, const SynthesisReport& report, Communicator* communicator) {
+  SoloCommunicator solo;
+  Communicator& ranks = communicator ? *communicator : solo;
+  const std::vector<double> seconds = ranks.allgather_value(synthesis_seconds);
+  const std::vector<double> exchange = ranks.allgather_value(report.exchange_seconds);
+  if (report.exchange_bytes_per_step <= 0) return;
+  std::printf("scale-out: %s exchanged per step\n", format_bytes(report.exchange_bytes_per_step).c_str());
+  for (std::size_t r = 0; r < seconds.size(); ++r)
+    std::printf("  rank %zu: synthesize() %s, exchange %s (%.1f%%)\n", r, format_seconds(seconds[r]).c_str(),
+                format_seconds(exchange[r]).c_str(), seconds[r] > 0 ? 100.0 * exchange[r] / seconds[r] : 0.0);
+}
+
+int run(const Options& options, cli::MpiSession& mpi) {
   if (options.help) {
     std::fputs(kUsage, stdout);
     return 0;
@@ -263,6 +282,10 @@ int run(const Options& options) {
     config.compute.transitions = parse_enum_option<TransitionStorage>("--transitions", options.transitions);
   if (!options.sweep.empty()) config.compute.sweep = parse_enum_option<SweepChoice>("--sweep", options.sweep);
   if (!options.platform.empty()) config.compute.platform = options.platform;
+  if (!options.devices.empty()) {
+    config.compute.devices = split_list(options.devices);
+    config.validate();
+  }
   const Abstraction abstraction = Abstraction::from_config(config);
   const double setup_seconds = seconds_since(setup_start);
 
@@ -273,10 +296,23 @@ int run(const Options& options) {
   print_memory_estimate(abstraction);
   std::printf("device: %s, transitions: %s\n", to_string(config.compute.device).c_str(),
               to_string(config.compute.transitions).c_str());
+  if (!config.compute.devices.empty()) {
+    std::string devices;
+    for (const std::string& entry : config.compute.devices) devices += (devices.empty() ? "" : ", ") + entry;
+    std::printf("devices: %s\n", devices.c_str());
+  }
+  if (mpi.size() > 1) std::printf("MPI: %d ranks\n", mpi.size());
   std::fflush(stdout);
 
   SynthesisOptions synthesis_options;
   synthesis_options.compute = config.compute;
+  synthesis_options.communicator = mpi.communicator();
+  if (options.dry_run) {
+    for (const std::string& line : describe_scale_out(abstraction, synthesis_options))
+      std::printf("plan: %s\n", line.c_str());
+    std::printf("dry run: nothing computed, no file written\n");
+    return 0;
+  }
   synthesis_options.profile = options.profile;
   const bool quiet = options.quiet;
   synthesis_options.progress = [quiet](const Progress& progress) {
@@ -291,9 +327,11 @@ int run(const Options& options) {
   std::printf("computed by %s, transitions %s\n", report.device.c_str(),
               report.transitions.c_str());
 
+  // Collective: every rank has finished its part before rank 0 writes the one file.
+  print_rank_times(synthesis_wall_seconds, report, mpi.communicator());
   const std::string output = options.output.empty() ? config.name + ".h5" : options.output;
   const auto write_start = Clock::now();
-  write_policy_file(output, policy, config);
+  if (mpi.rank() == 0) write_policy_file(output, policy, config);
   const double write_seconds = seconds_since(write_start);
 
   std::printf("wall time:\n");
@@ -309,29 +347,45 @@ int run(const Options& options) {
     compare_with_reference(abstraction, policy, synthesis_wall_seconds, engine_compute_seconds,
                            quiet);
   }
-  std::printf("wrote %s\n", output.c_str());
+  if (mpi.rank() == 0) std::printf("wrote %s\n", output.c_str());
   return 0;
+}
+
+// Runs the CLI; on failure prints the error (naming the rank under MPI) and returns the status.
+int run_reporting(int argc, char** argv, cli::MpiSession& mpi) {
+  const std::string where =
+      mpi.size() > 1 ? "rank " + std::to_string(mpi.rank()) + " of " + std::to_string(mpi.size()) + ": " : "";
+  auto report = [&](const std::exception& error, int status) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s%s\n", where.c_str(), error.what());
+    std::fflush(stderr);
+    return status;
+  };
+  try {
+    // Ranks other than 0 compute their part silently; errors still go to stderr.
+    if (mpi.rank() > 0 && !std::freopen("/dev/null", "w", stdout)) throw std::runtime_error("cannot silence stdout");
+    return run(parse_options(argc, argv), mpi);
+  } catch (const UsageError& error) {
+    return report(error, 2);
+  } catch (const ConfigError& error) {
+    return report(error, 2);
+  } catch (const ParseError& error) {
+    return report(error, 2);
+  } catch (const std::exception& error) {
+    return report(error, 1);
+  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
-    return run(parse_options(argc, argv));
-  } catch (const UsageError& error) {
-    std::fflush(stdout);
-    std::fprintf(stderr, "error: %s\n", error.what());
-    return 2;
-  } catch (const ConfigError& error) {
-    std::fflush(stdout);
-    std::fprintf(stderr, "error: %s\n", error.what());
-    return 2;
-  } catch (const ParseError& error) {
-    std::fflush(stdout);
-    std::fprintf(stderr, "error: %s\n", error.what());
-    return 2;
+    cli::MpiSession mpi(&argc, &argv);
+    const int status = run_reporting(argc, argv, mpi);
+    // One failing rank ends them all: the others would wait for it in the next exchange.
+    if (status != 0) mpi.abort_all(status);
+    return status;
   } catch (const std::exception& error) {
-    std::fflush(stdout);
     std::fprintf(stderr, "error: %s\n", error.what());
     return 1;
   }

@@ -74,6 +74,11 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
     text += "  platform: " + quoted(compute.platform) + "\n";
     text += "  device_name: " + quoted(compute.device_name) + "\n";
     text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";
+    if (!compute.devices.empty()) {
+      text += "  devices: [";
+      for (std::size_t i = 0; i < compute.devices.size(); ++i) text += (i ? ", " : "") + quoted(compute.devices[i]);
+      text += "]\n";
+    }
   }
   return text;
 }

@@ -316,6 +316,24 @@ void Config::validate() const {
     fail("compute.memory_fraction", format_number(compute.memory_fraction), "a fraction in (0, 1]",
          "memory_fraction: 0.5");
 
+  for (std::size_t i = 0; i < compute.devices.size(); ++i) {
+    const std::string& entry = compute.devices[i];
+    if (entry == "all") {
+      if (compute.devices.size() > 1)
+        fail(indexed("compute.devices", i), "'all' beside other devices", "`all` alone or a list of devices",
+             "devices: all");
+      continue;
+    }
+    if (!parse_device_selector(entry))
+      fail(indexed("compute.devices", i), "'" + entry + "'",
+           "gpu:N, cpu:N or P.D (--list-devices numbers), optionally /C to split it into sub-devices of C "
+           "compute units",
+           "devices: [gpu:0, gpu:1]");
+  }
+  if (!compute.devices.empty() && compute.device == DeviceKind::Reference)
+    fail("compute.devices", join(compute.devices), "no devices with compute.device: reference (it runs on the host)",
+         "device: auto");
+
   const double policy_bytes = state_points * ((double(spec.horizon) + 1) * 8 + double(spec.horizon) * 4);
   if (policy_bytes > kMaxPolicyBytes) {
     char text[300];

@@ -187,7 +187,7 @@ Config config_from_yaml(const YAML::Node& root) {
 
   if (present(root["compute"])) {
     const YAML::Node compute = root["compute"];
-    check_keys(compute, "compute", {"device", "transitions", "sweep", "platform", "device_name", "memory_fraction"},
+    check_keys(compute, "compute", {"device", "transitions", "sweep", "platform", "device_name", "memory_fraction", "devices"},
                "compute: {device: auto}");
     if (present(compute["device"]))
       config.compute.device = read_enum<DeviceKind>(
@@ -200,6 +200,17 @@ Config config_from_yaml(const YAML::Node& root) {
     if (present(compute["platform"])) config.compute.platform = read_string(compute["platform"], "compute.platform", "platform: nvidia");
     if (present(compute["device_name"]))
       config.compute.device_name = read_string(compute["device_name"], "compute.device_name", "device_name: \"0\"");
+    if (present(compute["devices"])) {
+      const YAML::Node devices = compute["devices"];
+      if (devices.IsScalar()) {
+        config.compute.devices = {read_string(devices, "compute.devices", "devices: all")};
+      } else if (devices.IsSequence()) {
+        for (std::size_t i = 0; i < devices.size(); ++i)
+          config.compute.devices.push_back(read_string(devices[i], indexed("compute.devices", i), "devices: [gpu:0, gpu:1]"));
+      } else {
+        fail("compute.devices", node_text(devices), "`all` or a list of devices", "devices: [gpu:0, gpu:1]");
+      }
+    }
     if (present(compute["memory_fraction"]))
       config.compute.memory_fraction =
           read_number(compute["memory_fraction"], "compute.memory_fraction", "memory_fraction: 0.5");

@@ -17,8 +17,10 @@ Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisRe
     return attempt(options, &first_report);
   } catch (const DeviceError& failure) {
     // Only `auto` without a platform or device selection may run elsewhere than asked.
+    // Several devices or ranks run as asked or fail together.
     const bool chosen_by_engine = options.compute.device == DeviceKind::Auto && options.compute.platform.empty() &&
-                                  options.compute.device_name.empty();
+                                  options.compute.device_name.empty() && options.compute.devices.empty() &&
+                                  !(options.communicator && options.communicator->size() > 1);
     if (!chosen_by_engine) throw;
     ComputeConfig on_cpu = options.compute;
     on_cpu.device = DeviceKind::Cpu;

@@ -18,82 +18,123 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-// Launches are split so that no single launch covers more entries than this (watchdogs, and
-// 32-bit work-item limits of some drivers).
-constexpr std::size_t kMaxLaunchEntries = std::size_t(1) << 30;
-constexpr std::size_t kGroupSize = 64;
+}  // namespace
 
-struct DeviceTable {
-  Buffer first, count, masses;
-};
-
-// Multiply-adds a stage does over all slices of one step: every tuple of the contracted
-// dimension's table occurs output_size / tuples times per slice, with its kept cells.
+// Every tuple of the contracted dimension's table occurs output_size / tuples times per slice,
+// with its kept cells.
 double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, std::size_t slices) {
   const double kept = std::accumulate(table.count.begin(), table.count.end(), 0.0);
   return double(stage.output_size) * double(slices) / double(table.count.size()) * kept;
 }
 
-}  // namespace
+StagePlacement stage_placement(const Abstraction& a, const FactoredPlan& plan, std::size_t k, std::size_t slice) {
+  // V's stride of the sliced dimension (row-major over the state grid).
+  std::uint64_t sliced_stride = 1;
+  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
+  const bool last = k + 1 == plan.stages.size();
+  const cl_uint block_first = cl_uint(slice * plan.slice_cells);
+  StagePlacement placement;
+  placement.in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
+  placement.lo = last ? block_first : 0;
+  placement.hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(plan.stages[k].dimension));
+  placement.accumulate = last && slice > 0;
+  return placement;
+}
+
+void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
+                         const StagePlacement& placement) {
+  check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &in), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &out), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &table.first.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &table.count.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 4, sizeof(cl_mem), &table.masses.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 5, sizeof(cl_ulong), &placement.in_offset), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &placement.lo), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &placement.hi), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
+}
+
+FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,
+                                       cl_context context, const std::string& cache_dir, bool entry_per_item,
+                                       std::vector<EngineNote>& notes) {
+  FactoredKernels kernels;
+  kernels.shape = stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+  notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                   std::string("factored stages: ") +
+                       (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
+                                                   : "one entry per work-item, neighbours contiguous (SIMT device)")});
+  kernels.program = build_program(context, device, factored_program_source(a, plan, kernels.shape), cache_dir, notes);
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    kernels.stages.push_back(create_kernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str()));
+  kernels.choose = create_kernel(kernels.program.get(), "choose_inputs");
+  return kernels;
+}
+
+std::vector<double> factored_terminal_values(const Abstraction& a) {
+  std::vector<double> terminal(a.states.size() + kTensorSlack, 0.0);
+  for (std::size_t x = 0; x < a.states.size(); ++x) terminal[x] = a.terminal_value(a.roles[x]);
+  return terminal;
+}
+
+FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPlan& plan,
+                                          const std::vector<MassTable>& tables, cl_context context) {
+  const std::size_t n_states = a.states.size();
+  FactoredBuffers buffers;
+  cl_int error = CL_SUCCESS;
+  auto make_buffer = [&](cl_mem_flags flags, std::size_t bytes, const void* host) {
+    Buffer buffer(clCreateBuffer(context, flags, std::max<std::size_t>(bytes, 8), const_cast<void*>(host), &error));
+    check(error, "clCreateBuffer");
+    buffers.device_bytes += bytes;
+    return buffer;
+  };
+  for (const MassTable& table : tables) {
+    const cl_mem_flags flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+    buffers.tables.push_back({make_buffer(flags, table.first.size() * sizeof(cl_uint), table.first.data()),
+                              make_buffer(flags, table.count.size() * sizeof(cl_uint), table.count.data()),
+                              make_buffer(flags, table.masses.size() * sizeof(double), table.masses.data())});
+  }
+  std::vector<cl_uchar> roles(n_states);
+  for (std::size_t x = 0; x < n_states; ++x) roles[x] = static_cast<cl_uchar>(a.roles[x]);
+  const std::vector<double> terminal = factored_terminal_values(a);
+  buffers.roles = make_buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n_states, roles.data());
+  for (Buffer& values : buffers.values)
+    values = make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data());
+  buffers.best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
+  buffers.q = make_buffer(CL_MEM_READ_WRITE, plan.q_size * sizeof(double), nullptr);
+  if (plan.stages.size() > 1)
+    for (Buffer& tensor : buffers.stage_tensors)
+      tensor = make_buffer(CL_MEM_READ_WRITE, (plan.largest_stage_tensor + kTensorSlack) * sizeof(double), nullptr);
+  return buffers;
+}
 
 Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const FactoredRunContext& run,
                           SynthesisReport& report) {
   const std::size_t n_states = a.states.size();
-  cl_int error = CL_SUCCESS;
-  std::size_t device_bytes = 0;
-  auto make_buffer = [&](cl_mem_flags flags, std::size_t bytes, const void* host) {
-    Buffer buffer(clCreateBuffer(run.context, flags, std::max<std::size_t>(bytes, 8), const_cast<void*>(host), &error));
-    check(error, "clCreateBuffer");
-    device_bytes += bytes;
-    return buffer;
-  };
 
   // --- kernel build
   auto phase_start = Clock::now();
-  const StageShape shape = stage_shape_for(run.entry_per_item ? 1 : run.device->native_double_width);
-  report.notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
-                          std::string("factored stages: ") +
-                              (shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
-                                                  : "one entry per work-item, neighbours contiguous (SIMT device)")});
-  Program program = build_program(run.context, *run.device, factored_program_source(a, plan, shape),
-                                  run.kernel_cache_dir, report.notes);
-  std::vector<Kernel> stage_kernels;
-  for (std::size_t k = 0; k < plan.stages.size(); ++k)
-    stage_kernels.push_back(create_kernel(program.get(), ("stage" + std::to_string(k)).c_str()));
-  const Kernel choose = create_kernel(program.get(), "choose_inputs");
+  FactoredKernels kernels = build_factored_kernels(a, plan, *run.device, run.context, run.kernel_cache_dir,
+                                                   run.entry_per_item, report.notes);
+  const StageShape shape = kernels.shape;
+  std::vector<Kernel>& stage_kernels = kernels.stages;
+  Kernel& choose = kernels.choose;
   report.phases.push_back({"kernel build", seconds_since(phase_start), 0, 0});
   if (run.progress) run.progress(Phase::Setup, 0, -1);
 
   // --- construction: the kept masses of every dimension, once
   phase_start = Clock::now();
   const std::vector<MassTable> tables = factored_mass_tables(a, plan);
-  std::vector<DeviceTable> device_tables;
-  for (const MassTable& table : tables) {
-    const cl_mem_flags flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-    device_tables.push_back({make_buffer(flags, table.first.size() * sizeof(cl_uint), table.first.data()),
-                             make_buffer(flags, table.count.size() * sizeof(cl_uint), table.count.data()),
-                             make_buffer(flags, table.masses.size() * sizeof(double), table.masses.data())});
-  }
-  std::vector<cl_uchar> roles(n_states);
-  std::vector<double> terminal(n_states);
-  for (std::size_t x = 0; x < n_states; ++x) {
-    roles[x] = static_cast<cl_uchar>(a.roles[x]);
-    terminal[x] = a.terminal_value(a.roles[x]);
-  }
-  Buffer roles_buffer = make_buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n_states, roles.data());
-  terminal.resize(n_states + kTensorSlack, 0.0);
-  Buffer values[2] = {
-      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data()),
-      make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data())};
-  Buffer best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
-  Buffer q = make_buffer(CL_MEM_READ_WRITE, plan.q_size * sizeof(double), nullptr);
-  Buffer stage_tensors[2];
-  if (plan.stages.size() > 1)
-    for (Buffer& tensor : stage_tensors)
-      tensor = make_buffer(CL_MEM_READ_WRITE, (plan.largest_stage_tensor + kTensorSlack) * sizeof(double), nullptr);
-  report.device_bytes = device_bytes;
+  FactoredBuffers buffers = allocate_factored_buffers(a, plan, tables, run.context);
+  const std::vector<DeviceTable>& device_tables = buffers.tables;
+  Buffer& roles_buffer = buffers.roles;
+  Buffer* values = buffers.values;
+  Buffer& best_input = buffers.best_input;
+  Buffer& q = buffers.q;
+  Buffer* stage_tensors = buffers.stage_tensors;
+  const std::vector<double> terminal = factored_terminal_values(a);
+  report.device_bytes = buffers.device_bytes;
   report.notes.push_back({NoteSeverity::Info, NoteKind::DeviceMemory,
-                          "device memory: " + std::to_string(device_bytes / 1048576) + " MiB"});
+                          "device memory: " + std::to_string(buffers.device_bytes / 1048576) + " MiB"});
   const double construction_seconds = seconds_since(phase_start);
   report.phases.push_back({"construction", construction_seconds,
                            double(a.pairs()) / std::max(construction_seconds, 1e-9), 0});
@@ -112,11 +153,11 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   }
   stage_bytes.back() = 8.0 * double(plan.q_size) + 12.0 * double(n_states);
   bytes_per_step += stage_bytes.back();
-  const std::size_t group = std::min(kGroupSize, std::max<std::size_t>(1, run.device->max_work_group));
+  const std::size_t group = std::min(kFactoredGroupSize, std::max<std::size_t>(1, run.device->max_work_group));
   auto launch = [&](cl_kernel kernel, std::size_t entries, std::size_t timing_slot) {
     const auto launch_start = Clock::now();
-    for (std::size_t offset = 0; offset < entries; offset += kMaxLaunchEntries) {
-      const std::size_t count = std::min(kMaxLaunchEntries, entries - offset);
+    for (std::size_t offset = 0; offset < entries; offset += kFactoredMaxLaunchItems) {
+      const std::size_t count = std::min(kFactoredMaxLaunchItems, entries - offset);
       const std::size_t global = (count + group - 1) / group * group;
       check(clEnqueueNDRangeKernel(run.queue, kernel, 1, &offset, &global, &group, 0, nullptr, nullptr),
             "clEnqueueNDRangeKernel(factored sweep)");
@@ -133,15 +174,11 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
             policy.values.begin() + std::ptrdiff_t(a.horizon * n_states));
 
   const std::size_t last_stage = plan.stages.size() - 1;
-  // V's stride of the sliced dimension (row-major over the state grid).
-  std::uint64_t sliced_stride = 1;
-  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
   const auto synthesis_start = Clock::now();
   int current = 0;
   for (unsigned step = a.horizon; step-- > 0;) {
     phase_start = Clock::now();
     for (std::size_t slice = 0; slice < plan.slices; ++slice) {
-      const cl_uint block_first = cl_uint(slice * plan.slice_cells);
       for (std::size_t k = 0; k < plan.stages.size(); ++k) {
         const FactoredStage& stage = plan.stages[k];
         const DeviceTable& table = device_tables[stage.dimension];
@@ -149,20 +186,8 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
         cl_mem in = k == 0 ? values[current].get() : stage_tensors[(k - 1) % 2].get();
         cl_mem out = last ? q.get() : stage_tensors[k % 2].get();
         // The first stage reads the slice out of V; the last contracts the slice's cells only.
-        const cl_ulong in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
-        const cl_uint lo = last ? block_first : 0;
-        const cl_uint hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(stage.dimension));
-        const cl_uint accumulate = last && slice > 0;
         cl_kernel kernel = stage_kernels[k].get();
-        check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &in), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &out), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &table.first.handle), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &table.count.handle), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 4, sizeof(cl_mem), &table.masses.handle), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 5, sizeof(cl_ulong), &in_offset), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &lo), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &hi), "clSetKernelArg");
-        check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &accumulate), "clSetKernelArg");
+        set_stage_arguments(kernel, in, out, table, stage_placement(a, plan, k, slice));
         launch(kernel, stage_work_items(stage, shape), k);
       }
     }

@@ -15,6 +15,7 @@
 #include "opencl_program_cache.hpp"
 #include "opencl_run.hpp"
 #include "opencl_source.hpp"
+#include "team.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -37,6 +38,8 @@ void check_supported(const Abstraction& a) {
     throw ConfigError("states", "the OpenCL engine supports fewer than 2^32 state cells (got " +
                                     std::to_string(a.states.size()) + ")");
 }
+
+}  // namespace
 
 // The dense sweep's padded value array is indexed with 32 bits.
 void check_dense_supported(const Layout& layout) {
@@ -83,8 +86,6 @@ void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded
   for (std::size_t x = 0; x < padded_index.size(); ++x) out[x] = padded[padded_index[x]];
 }
 
-}  // namespace
-
 Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, SynthesisReport* report,
                          const OpenClEngineOptions& engine_options) {
   const auto start = Clock::now();
@@ -92,6 +93,7 @@ Policy synthesize_opencl(const Abstraction& a, const SynthesisOptions& options, 
   SynthesisReport& rep = report ? *report : local_report;
   const Layout layout(a);
   check_supported(a);
+  if (is_scale_out(options)) return synthesize_team(a, options, rep, engine_options);
 
   auto phase_start = Clock::now();
   const DeviceInfo device = choose_device(options.compute, rep.notes);

@@ -4,11 +4,16 @@
 // (building it), opencl_layout (memory layout), opencl_run (buffers and launches).
 #include <cstddef>
 #include <functional>
+#include <optional>
+#include <vector>
 #include <string>
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/policy.hpp"
+#include "factored_plan.hpp"
+#include "opencl_device.hpp"
+#include "opencl_layout.hpp"
 
 namespace amytiss::detail {
 
@@ -34,6 +39,21 @@ struct OpenClEngineOptions {
 /// The OpenCL engine (device chosen by options.compute, see synthesize()).
 Policy synthesize_opencl(const Abstraction& abstraction, const SynthesisOptions& options,
                          SynthesisReport* report, const OpenClEngineOptions& engine_options = {});
+
+/// Several devices or ranks (compute.devices, options.communicator): the states, or the factored
+/// sweep's stage entries, split over them (team_dense.cpp, team_factored.cpp, docs/scale_out.md).
+Policy synthesize_team(const Abstraction& abstraction, const SynthesisOptions& options, SynthesisReport& report,
+                       const OpenClEngineOptions& engine_options);
+
+/// Parts of the engine that the single-device and the several-device runs share
+/// (opencl_engine.cpp). The dense sweep's limit on the padded value array (ConfigError).
+void check_dense_supported(const Layout& layout);
+/// The factored plan when compute.sweep asks for it or it saves enough work (nullopt: dense); a
+/// Sweep note says which and why.
+std::optional<FactoredPlan> choose_factored(const Abstraction& abstraction, const DeviceInfo& device,
+                                            const SynthesisOptions& options, SynthesisReport& report);
+/// Step `step` of the policy's values from a padded value array.
+void unpad(Policy& policy, unsigned step, const std::vector<std::size_t>& padded_index, const double* padded);
 
 /// Label ("platform / device") of the device that `compute` selects, or "" when none matches.
 std::string selected_device_label(const ComputeConfig& compute);

@@ -55,14 +55,19 @@ DeviceSession open_session(const DeviceInfo& device) {
 }
 
 RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& device, const SynthesisOptions& options,
-                 const OpenClEngineOptions& engine_options, SynthesisReport& rep) {
+                 const OpenClEngineOptions& engine_options, SynthesisReport& rep, std::size_t slice_first,
+                 std::size_t slice_end) {
   RunPlan plan;
-  const std::size_t n_states = a.states.size(), n_inputs = a.inputs.size();
+  const std::size_t n_inputs = a.inputs.size();
+  plan.slice_first = slice_first;
+  plan.slice_end = std::min(slice_end, a.states.size());
+  // The records this device stores: its slice's.
+  const std::size_t n_states = plan.slice_end - plan.slice_first;
   plan.records_per_state = n_inputs * a.disturbances.size();
   // Stored when the records fit the budget, else on the fly.
   const std::size_t masses_per_state = plan.records_per_state * sizeof(float) * std::size_t(layout.mass_record);
   const std::size_t value_cells = layout.padded_size + kValueSlack;
-  const std::size_t base_bytes = 2 * value_cells * sizeof(double) + n_states * (1 + sizeof(cl_uint));
+  const std::size_t base_bytes = 2 * value_cells * sizeof(double) + a.states.size() * (1 + sizeof(cl_uint));
   const double budget = options.compute.memory_fraction * double(device.global_memory);
   const double stored_bytes = double(n_states) * double(plan.records_per_state) * double(layout.record_bytes());
   const std::size_t max_states_by_allocation =
@@ -111,7 +116,7 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
     states_per_chunk = std::min(states_per_chunk, kGroupPerStateMaxStates);
   if (engine_options.max_states_per_chunk)
     states_per_chunk = std::min(states_per_chunk, engine_options.max_states_per_chunk);
-  plan.states_per_chunk = std::min(states_per_chunk, n_states);
+  plan.states_per_chunk = std::max<std::size_t>(1, std::min(states_per_chunk, n_states));
   return plan;
 }
 
@@ -141,10 +146,10 @@ RunBuffers allocate_buffers(const Abstraction& a, const Layout& layout, const Ru
     values = make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, value_cells * sizeof(double),
                          buffers.terminal.data());
   buffers.best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
-  for (std::size_t first = 0; first < n_states; first += plan.states_per_chunk) {
+  for (std::size_t first = plan.slice_first; first < plan.slice_end; first += plan.states_per_chunk) {
     Chunk chunk;
     chunk.first = first;
-    chunk.count = std::min(plan.states_per_chunk, n_states - first);
+    chunk.count = std::min(plan.states_per_chunk, plan.slice_end - first);
     const std::size_t records = plan.on_the_fly ? 1 : chunk.count * plan.records_per_state;
     chunk.starts = make_buffer(CL_MEM_READ_WRITE, records * sizeof(cl_uint), nullptr);
     chunk.masses = make_buffer(CL_MEM_READ_WRITE, records * sizeof(float) * std::size_t(layout.mass_record), nullptr);
@@ -159,7 +164,8 @@ RunBuffers allocate_buffers(const Abstraction& a, const Layout& layout, const Ru
   return buffers;
 }
 
-void construct_transitions(cl_command_queue queue, cl_kernel construct, const RunPlan& plan, RunBuffers& buffers) {
+void construct_transitions(cl_command_queue queue, cl_kernel construct, const RunPlan& plan, RunBuffers& buffers,
+                           bool wait) {
   for (Chunk& chunk : buffers.chunks) {
     const cl_ulong triple_begin = cl_ulong(chunk.first) * plan.records_per_state;
     const cl_ulong triple_count = cl_ulong(chunk.count) * plan.records_per_state;
@@ -171,11 +177,10 @@ void construct_transitions(cl_command_queue queue, cl_kernel construct, const Ru
     check(clEnqueueNDRangeKernel(queue, construct, 1, nullptr, &global, &kConstructGroup, 0, nullptr, nullptr),
           "clEnqueueNDRangeKernel(construct)");
   }
-  check(clFinish(queue), "clFinish(construct)");
+  if (wait) check(clFinish(queue), "clFinish(construct)");
 }
 
-void sweep_step(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, RunBuffers& buffers, int current,
-                std::uint32_t* input_index, std::vector<double>& padded_values) {
+void enqueue_sweep(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, RunBuffers& buffers, int current) {
   for (Chunk& chunk : buffers.chunks) {
     const cl_uint state_begin = cl_uint(chunk.first), state_count = cl_uint(chunk.count);
     set_argument(sweep, 0, sizeof(cl_mem), &buffers.values[current].handle);
@@ -192,6 +197,11 @@ void sweep_step(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, Ru
     check(clEnqueueNDRangeKernel(queue, sweep, 1, nullptr, &global, &local, 0, nullptr, nullptr),
           "clEnqueueNDRangeKernel(synthesize)");
   }
+}
+
+void sweep_step(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, RunBuffers& buffers, int current,
+                std::uint32_t* input_index, std::vector<double>& padded_values) {
+  enqueue_sweep(queue, sweep, plan, buffers, current);
   const std::size_t n_states = buffers.padded_index.size();
   check(clEnqueueReadBuffer(queue, buffers.best_input.get(), CL_FALSE, 0, n_states * sizeof(cl_uint), input_index, 0,
                             nullptr, nullptr),

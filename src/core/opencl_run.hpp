@@ -3,6 +3,7 @@
 // fly), how the sweep maps to work-items, the device buffers, the construction launches, one
 // sweep step and its read-back. opencl_engine.cpp strings these together.
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
@@ -31,12 +32,15 @@ struct RunPlan {
   std::size_t group_size = 1;        ///< work-items per group of synthesize_group (a power of 2)
   std::size_t states_per_chunk = 1;  ///< states per stored-record buffer and per launch
   std::size_t records_per_state = 1; ///< inputs x disturbances
+  std::size_t slice_first = 0;       ///< the states this device sweeps: [slice_first, slice_end)
+  std::size_t slice_end = 0;
 };
 /// Stored when the records fit options.compute.memory_fraction of the device memory and its
 /// allocation limit (or as requested), the sweep variant from the device type; notes say why.
+/// With several devices, `slice` is this device's states (default: all of them).
 RunPlan plan_run(const Abstraction& abstraction, const Layout& layout, const DeviceInfo& device,
                  const SynthesisOptions& options, const OpenClEngineOptions& engine_options,
-                 SynthesisReport& report);
+                 SynthesisReport& report, std::size_t slice_first = 0, std::size_t slice_end = SIZE_MAX);
 
 /// The states of one chunk and their transition records (one-element buffers on the fly).
 struct Chunk {
@@ -58,8 +62,13 @@ struct RunBuffers {
 RunBuffers allocate_buffers(const Abstraction& abstraction, const Layout& layout, const RunPlan& plan,
                             cl_context context, SynthesisReport& report);
 
-/// Launches the construction kernel over every chunk's triples and waits for it.
-void construct_transitions(cl_command_queue queue, cl_kernel construct, const RunPlan& plan, RunBuffers& buffers);
+/// Launches the construction kernel over every chunk's triples and waits for it (wait false:
+/// only enqueues).
+void construct_transitions(cl_command_queue queue, cl_kernel construct, const RunPlan& plan, RunBuffers& buffers,
+                           bool wait = true);
+
+/// Enqueues the sweep kernel over every chunk from values[current] into values[1 - current].
+void enqueue_sweep(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, RunBuffers& buffers, int current);
 
 /// One step of the backward recursion: sweep kernel over every chunk from values[current] into
 /// values[1 - current], then reads back the best inputs into `input_index` (one per state) and

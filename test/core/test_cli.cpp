@@ -12,70 +12,24 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/policy_file.hpp"
+#include "cli_support.hpp"
 
 namespace amytiss {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::CliTest;
+using test_support::CommandResult;
+using test_support::kSynth;
+using test_support::quote;
 
 const std::string kSourceDir = AMYTISS_SOURCE_DIR;
-const std::string kSynth = AMYTISS_SYNTH_BIN;
 const std::string kTinyConfig = kSourceDir + "/test/data/cli_tiny.yaml";
 const std::string kBadEtaConfig = kSourceDir + "/test/data/cli_bad_eta.yaml";
 // cli_tiny.yaml: 9 x 9 states, 3 x 3 inputs, horizon 4.
 constexpr std::size_t kTinyStates = 81, kTinyInputs = 9;
 // Two runs of the same engine on the same problem agree exactly.
 constexpr double kSameEngineTolerance = 0.0;
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string read_file(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-std::string quote(const std::string& text) { return "'" + text + "'"; }
-
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    directory_ = fs::temp_directory_path() /
-                 ("amytiss_cli_test_" + std::to_string(::getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(directory_);
-    fs::create_directories(directory_);
-  }
-  void TearDown() override { fs::remove_all(directory_); }
-
-  // Runs `command` in the test's directory with stdout and stderr captured to files.
-  CommandResult run_in_directory(const std::string& command) const {
-    const fs::path out = directory_ / "stdout.txt", err = directory_ / "stderr.txt";
-    const std::string line = "cd " + quote(directory_.string()) + " && " + command + " >" +
-                             quote(out.string()) + " 2>" + quote(err.string());
-    const int status = std::system(line.c_str());
-    CommandResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = read_file(out);
-    result.err = read_file(err);
-    fs::remove(out);
-    fs::remove(err);
-    return result;
-  }
-  CommandResult synth(const std::string& arguments) const {
-    return run_in_directory(quote(kSynth) + " " + arguments);
-  }
-  std::string path(const std::string& name) const { return (directory_ / name).string(); }
-
-  fs::path directory_;
-};
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string::npos, (haystack).find(needle)) << "missing '" << (needle) << "' in:\n" << (haystack)
 
 TEST_F(CliTest, HelpListsEveryOption) {
   const CommandResult result = synth("--help");
