@@ -29,7 +29,9 @@ class SynthesizerAndServerTest : public ::testing::Test {
 
   void SetUp() override {
     ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(kServiceWaitSeconds)));
-    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input");
+    // One persistent connection: a new TCP connection per call would leave a socket in TIME_WAIT
+    // per call, and loops of calls can exhaust the ephemeral ports of a busy machine.
+    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
     ASSERT_TRUE(action_.waitForServer(ros::Duration(kServiceWaitSeconds)));
     ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.ready && !s.synthesizing; },
                                  kPolicyWaitSeconds))

@@ -25,7 +25,8 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   std::atomic<int> answered{0}, failed{0};
   std::string first_failure;  // written by the caller thread only, read after join()
   std::thread caller([&] {
-    ros::ServiceClient client = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input");
+    // One persistent connection for the whole loop (see rostest_fixture.hpp).
+    ros::ServiceClient client = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
     while (!stop) {
       amytiss_msgs::GetInput service;
       service.request.state = {-4.0, -4.0};

@@ -20,7 +20,8 @@ class ServiceTest : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
-    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input");
+    // One persistent connection (see rostest_fixture.hpp).
+    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
     ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.ready; },
                                  amytiss_test::kPolicyWaitSeconds))
         << "no ready policy; last status: " << status_.latest().message;
