@@ -1,6 +1,7 @@
 # Shared by scripts/test and scripts/demo (sourced, not run).
-# The catkin workspace lives in .ws/ at the repository root (AMYTISS_WS overrides); the package
-# is linked into its src/ so the checkout itself is what gets built.
+# The catkin workspace lives in .ws/ at the repository root (AMYTISS_WS overrides); the two
+# packages (amytiss at the root, amytiss_msgs in amytiss_msgs/) are linked into its src/ so the
+# checkout itself is what gets built (catkin does not look for packages inside a package).
 AMYTISS_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 AMYTISS_WS=${AMYTISS_WS:-$AMYTISS_ROOT/.ws}
 # ROS tools need Debian's python3 (a pyenv python3 may come first on PATH and lacks catkin).
@@ -14,10 +15,15 @@ amytiss_install() {
 
 amytiss_workspace() {
   mkdir -p "$AMYTISS_WS/src" "$ROS_HOME"
-  local link="$AMYTISS_WS/src/amytiss"
-  if [ "$(readlink -f "$link" 2>/dev/null)" != "$AMYTISS_ROOT" ]; then
+  amytiss_link "$AMYTISS_WS/src/amytiss" "$AMYTISS_ROOT"
+  amytiss_link "$AMYTISS_WS/src/amytiss_msgs" "$AMYTISS_ROOT/amytiss_msgs"
+}
+
+amytiss_link() {
+  local link=$1 target=$2
+  if [ "$(readlink -f "$link" 2>/dev/null)" != "$target" ]; then
     rm -rf "$link"
-    ln -s "$AMYTISS_ROOT" "$link"
+    ln -s "$target" "$link"
   fi
 }
 

@@ -26,7 +26,8 @@ def main(argv):
         if text(attributes.get("format", "")) != "amytiss-policy":
             print(f"error: {argv[1]} is not an amytiss policy", file=sys.stderr)
             return 1
-        for name in ("format", "format_version", "config_hash", "computed_by", "horizon", "spec"):
+        for name in ("format", "format_version", "config_hash", "computed_by", "run_id", "engine_version",
+                     "horizon", "spec", "content_digest"):
             print(f"attribute {name} = {text(attributes[name])}")
 
         datasets = []
@@ -34,7 +35,8 @@ def main(argv):
             lambda name, item: datasets.append((name, item)) if isinstance(item, h5py.Dataset) else None)
         for name, dataset in sorted(datasets):
             kind = "string" if h5py.check_string_dtype(dataset.dtype) else str(dataset.dtype)
-            print(f"dataset /{name} {kind} {tuple(dataset.shape)}")
+            checksum = " fletcher32" if dataset.fletcher32 else ""
+            print(f"dataset /{name} {kind} {tuple(dataset.shape)}{checksum}")
 
         values = policy_file["values"][0]
         roles = policy_file["roles"][()]

@@ -24,6 +24,16 @@
 
 namespace amytiss {
 
+/// Limits of one expression; beyond them parse() throws a ParseError that names the limit. They
+/// bound the memory and stack any input can take (evaluate() and to_c() recurse at most
+/// kMaxExpressionDepth deep); real dynamics stay far below them.
+constexpr std::size_t kMaxExpressionLength = 65536;  // characters
+constexpr std::size_t kMaxExpressionDepth = 256;     // nesting levels: '(', arguments, '?:', unary, '^'
+constexpr std::size_t kMaxExpressionNodes = 10000;   // numbers, variables, operators and calls
+
+/// `text` itself when short, else its first characters and its length: for error messages.
+std::string expression_excerpt(const std::string& text);
+
 struct ExpressionNode;  // defined in the .cpp
 
 /// Which components an expression reads: sorted, distinct indices of x, u and w.

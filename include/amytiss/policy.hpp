@@ -35,6 +35,9 @@ struct Policy {
   /// What computed it (device name or "reference") and the configuration's hash.
   std::string computed_by;
   std::string config_hash;
+  /// Identity of the synthesis run that computed it: 16 hex digits of a random 64-bit number,
+  /// drawn by synthesize() (new_run_id()). Two runs of one configuration differ in run_id.
+  std::string run_id;
 
   double value(unsigned step, std::size_t cell) const { return values[std::size_t(step) * states.size() + cell]; }
   std::uint32_t input(unsigned step, std::size_t cell) const {
@@ -59,5 +62,8 @@ struct ValueSummary {
   std::size_t free_cells = 0, cells_at_least_half = 0;
 };
 ValueSummary summarize_initial_values(const Policy& policy);
+
+/// A fresh random run id (16 lowercase hex digits) from std::random_device.
+std::string new_run_id();
 
 }  // namespace amytiss

@@ -1,18 +1,21 @@
 #pragma once
-// Policy files (HDF5). Layout (format_version 1), all documented in README "Policy file":
-//   attributes on /: format = "amytiss-policy", format_version = 1, config_hash (16 hex digits),
-//                    computed_by, horizon, spec
+// Policy files (HDF5). Layout (format_version 2), all documented in docs/policy_file.md:
+//   attributes on /: format = "amytiss-policy", format_version = 2, config_hash (16 hex digits),
+//                    computed_by, run_id (16 hex digits), engine_version, horizon, spec,
+//                    content_digest (16 hex digits over all attributes and datasets)
 //   /config            string: canonical YAML of the configuration (to_yaml)
 //   /states/{lb,eta,counts}, /inputs/{lb,eta,counts}   float64 / uint64 vectors
 //   /values            float64 (horizon+1, n0, n1, ...)   V_k(x)
 //   /input_index       uint32  (horizon,   n0, n1, ...)   flat index of u*(x,k) in the input grid
 //   /input_values      float64 (n_inputs, input_dims)      the input grid's points
 //   /roles             uint8   (n0, n1, ...)  0 free, 1 fixed zero (avoid/unsafe), 2 fixed one (target)
-// Files are written to "<path>.tmp.<pid>" and renamed, so a reader never sees half a file.
+// Every non-empty array is chunked with HDF5's Fletcher-32 checksum. Files are written to
+// "<path>.tmp.<pid>" and renamed, so a reader never sees half a file.
 #include <string>
 
 #include "amytiss/config.hpp"
 #include "amytiss/policy.hpp"
+#include "amytiss/version.hpp"
 
 namespace amytiss {
 
@@ -23,20 +26,25 @@ struct LoadedPolicy {
   Policy policy;
   std::string config_yaml;
   std::string config_hash;
+  unsigned engine_version = 0;  ///< kEngineVersion of the build that computed it
 };
 
-/// Reads a policy file. Throws PolicyFileError when the file is missing, truncated, corrupt, not
-/// an amytiss policy or of another format version, with a message that says which.
+/// Reads a policy file and verifies its checksums (Fletcher-32 of each array, the content digest
+/// of everything). Throws PolicyFileError when the file is missing, truncated, corrupt (a
+/// checksum does not match), not an amytiss policy or of another format version, with a message
+/// that says which.
 LoadedPolicy read_policy_file(const std::string& path);
-/// Reads and checks that the file was made from `config` (same config_hash); throws
-/// PolicyFileError naming both hashes otherwise.
+/// Reads and checks that the file was made from `config` (same config_hash) by this build's
+/// engine version (kEngineVersion); throws PolicyFileError naming both otherwise. This decides
+/// whether a stored policy may be reused.
 LoadedPolicy read_policy_file_for(const std::string& path, const Config& config);
 
 namespace detail {
-/// write_policy_file with a chosen format name and version and without the value checks (values
-/// in [0, 1], input indices in range): only for tests of the reader's refusals.
+/// write_policy_file with a chosen format name, format version and engine version and without the
+/// value checks (values in [0, 1], input indices in range): only for tests of the reader's refusals.
 void write_policy_file_as(const std::string& path, const Policy& policy, const Config& config,
-                          const std::string& format, unsigned format_version);
+                          const std::string& format, unsigned format_version,
+                          unsigned engine_version = kEngineVersion);
 }  // namespace detail
 
 }  // namespace amytiss

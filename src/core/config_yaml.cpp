@@ -189,8 +189,12 @@ Config config_from_yaml(const YAML::Node& root) {
   } else {
     const std::string horizon_example = "horizon: 16 (or horizon: infinite)";
     const double horizon = read_number(horizon_node, "spec.horizon", horizon_example);
-    if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= 1e9))
-      fail("spec.horizon", horizon_node.Scalar(), "an integer >= 1 (number of time steps) or infinite", horizon_example);
+    constexpr double kMaxHorizon = 1e9;  // the policy arrays' 16 GiB limit is checked in validate()
+    if (!(horizon >= 0 && horizon == std::floor(horizon) && horizon <= kMaxHorizon))
+      fail("spec.horizon", horizon_node.Scalar(),
+           "an integer >= 1 and <= 1000000000 (number of time steps; the policy arrays must also fit in 16 GiB) "
+           "or infinite",
+           horizon_example);
     config.spec.horizon = static_cast<unsigned>(horizon);
   }
   if (present(spec["tolerance"])) {

@@ -45,8 +45,10 @@ Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisRe
 
 }  // namespace detail
 
-Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
-                  SynthesisReport* report) {
+namespace {
+
+Policy synthesize_on_device(const Abstraction& abstraction, const SynthesisOptions& options,
+                            SynthesisReport* report) {
   if (options.compute.device == DeviceKind::Reference) {
     if (report) report->notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device: reference (serial, double precision)"});
     return synthesize_reference(abstraction, options.progress, report);
@@ -57,6 +59,15 @@ Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& option
         return detail::synthesize_opencl(abstraction, attempt_options, attempt_report);
       },
       detail::selected_device_label);
+}
+
+}  // namespace
+
+Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
+                  SynthesisReport* report) {
+  Policy policy = synthesize_on_device(abstraction, options, report);
+  policy.run_id = new_run_id();
+  return policy;
 }
 
 }  // namespace amytiss

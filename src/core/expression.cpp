@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
@@ -11,7 +12,9 @@
 
 namespace amytiss {
 
-enum class NodeKind { Number, Variable, Unary, Binary, Call, Conditional };
+// Chain: a left-associative run of '+'/'-' (or '*'/'/') kept flat, so a long sum is a loop in
+// evaluate() and to_c(), not a deep tree.
+enum class NodeKind { Number, Variable, Unary, Binary, Chain, Call, Conditional };
 enum class VariableSpace { State, Input, Disturbance, Noise };
 // Resolved when the node is built so that evaluation switches on an integer, never on text.
 enum class Operation {
@@ -28,6 +31,26 @@ struct ExpressionNode {
   std::string op;  // operator symbol (unary/binary) or function name (call), for to_c()
   Operation operation = Operation::None;
   std::vector<std::shared_ptr<const ExpressionNode>> children;
+  std::vector<Operation> chain_operations;  // Chain: the operation joining children[i] and children[i+1]
+  std::size_t height = 1;                   // levels of this subtree (a leaf: 1)
+
+  ExpressionNode() = default;
+  ExpressionNode(const ExpressionNode&) = delete;
+  ExpressionNode& operator=(const ExpressionNode&) = delete;
+  // The default destructor would recurse once per tree level; a tree abandoned half-built by a
+  // ParseError may be deeper than the depth limit, so descendants are released from a list.
+  ~ExpressionNode() {
+    std::vector<std::shared_ptr<const ExpressionNode>> pending = std::move(children);
+    while (!pending.empty()) {
+      std::shared_ptr<const ExpressionNode> node = std::move(pending.back());
+      pending.pop_back();
+      if (node.use_count() == 1) {
+        auto& grandchildren = const_cast<ExpressionNode&>(*node).children;
+        for (auto& child : grandchildren) pending.push_back(std::move(child));
+        grandchildren.clear();
+      }
+    }
+  }
 };
 
 namespace {
@@ -171,21 +194,15 @@ std::vector<Token> tokenize(const std::string& text) {
   return tokens;
 }
 
-NodePtr make_number(double value) {
-  auto node = std::make_shared<ExpressionNode>();
-  node->kind = NodeKind::Number;
-  node->number = value;
-  return node;
-}
-
-NodePtr make_operator(NodeKind kind, const std::string& op, std::vector<NodePtr> children) {
-  auto node = std::make_shared<ExpressionNode>();
-  node->kind = kind;
-  node->op = op;
-  node->children = std::move(children);
-  if (kind == NodeKind::Unary || kind == NodeKind::Binary) node->operation = operator_operation(kind, op);
-  if (kind == NodeKind::Call) node->operation = find_function(op)->operation;
-  return node;
+const char* chain_symbol(Operation operation) {
+  switch (operation) {
+    case Operation::Add: return "+";
+    case Operation::Subtract: return "-";
+    case Operation::Multiply: return "*";
+    case Operation::Divide: return "/";
+    case Operation::And: return "&&";
+    default: return "||";
+  }
 }
 
 class Parser {
@@ -218,7 +235,65 @@ class Parser {
     return token;
   }
 
-  NodePtr parse_expr() { return parse_conditional(); }
+  // Counts one nesting level while alive; every recursive descent passes through one, so the
+  // parser's stack stays proportional to kMaxExpressionDepth.
+  class Nesting {
+   public:
+    explicit Nesting(Parser& parser) : parser_(parser) {
+      if (++parser_.depth_ > kMaxExpressionDepth)
+        throw ParseError(parser_.peek().column, "nested deeper than the limit of " +
+                                                    std::to_string(kMaxExpressionDepth) + " levels" + kDepthHint);
+    }
+    ~Nesting() { --parser_.depth_; }
+
+   private:
+    Parser& parser_;
+  };
+  static constexpr const char* kDepthHint =
+      " (each parenthesis, function argument, '?:' branch, unary operator and '^' is a level)";
+
+  NodePtr count(std::shared_ptr<ExpressionNode> node) {
+    if (++nodes_ > kMaxExpressionNodes)
+      throw ParseError(peek().column, "more than the limit of " + std::to_string(kMaxExpressionNodes) +
+                                          " terms (numbers, variables, operators and calls)");
+    for (const auto& child : node->children) node->height = std::max(node->height, child->height + 1);
+    if (node->height > kMaxExpressionDepth)
+      throw ParseError(peek().column, "nested deeper than the limit of " + std::to_string(kMaxExpressionDepth) +
+                                          " levels" + kDepthHint);
+    return node;
+  }
+
+  NodePtr make_number(double value) {
+    auto node = std::make_shared<ExpressionNode>();
+    node->kind = NodeKind::Number;
+    node->number = value;
+    return count(std::move(node));
+  }
+
+  NodePtr make_operator(NodeKind kind, const std::string& op, std::vector<NodePtr> children) {
+    auto node = std::make_shared<ExpressionNode>();
+    node->kind = kind;
+    node->op = op;
+    node->children = std::move(children);
+    if (kind == NodeKind::Unary || kind == NodeKind::Binary) node->operation = operator_operation(kind, op);
+    if (kind == NodeKind::Call) node->operation = find_function(op)->operation;
+    return count(std::move(node));
+  }
+
+  // One operand gives the operand itself; more give a flat left-associative Chain.
+  NodePtr make_chain(std::vector<NodePtr> operands, std::vector<Operation> operations) {
+    if (operands.size() == 1) return operands.front();
+    auto node = std::make_shared<ExpressionNode>();
+    node->kind = NodeKind::Chain;
+    node->children = std::move(operands);
+    node->chain_operations = std::move(operations);
+    return count(std::move(node));
+  }
+
+  NodePtr parse_expr() {
+    Nesting nesting(*this);
+    return parse_conditional();
+  }
 
   NodePtr parse_conditional() {
     NodePtr condition = parse_or();
@@ -234,21 +309,25 @@ class Parser {
   }
 
   NodePtr parse_or() {
-    NodePtr left = parse_and();
+    std::vector<NodePtr> operands{parse_and()};
+    std::vector<Operation> operations;
     while (peek_operator("||")) {
       next();
-      left = make_operator(NodeKind::Binary, "||", {left, parse_and()});
+      operands.push_back(parse_and());
+      operations.push_back(Operation::Or);
     }
-    return left;
+    return make_chain(std::move(operands), std::move(operations));
   }
 
   NodePtr parse_and() {
-    NodePtr left = parse_comparison();
+    std::vector<NodePtr> operands{parse_comparison()};
+    std::vector<Operation> operations;
     while (peek_operator("&&")) {
       next();
-      left = make_operator(NodeKind::Binary, "&&", {left, parse_comparison()});
+      operands.push_back(parse_comparison());
+      operations.push_back(Operation::And);
     }
-    return left;
+    return make_chain(std::move(operands), std::move(operations));
   }
 
   NodePtr parse_comparison() {
@@ -268,24 +347,27 @@ class Parser {
   }
 
   NodePtr parse_sum() {
-    NodePtr left = parse_product();
+    std::vector<NodePtr> operands{parse_product()};
+    std::vector<Operation> operations;
     while (peek_operator("+") || peek_operator("-")) {
-      const std::string op = next().text;
-      left = make_operator(NodeKind::Binary, op, {left, parse_product()});
+      operations.push_back(next().text == "+" ? Operation::Add : Operation::Subtract);
+      operands.push_back(parse_product());
     }
-    return left;
+    return make_chain(std::move(operands), std::move(operations));
   }
 
   NodePtr parse_product() {
-    NodePtr left = parse_unary();
+    std::vector<NodePtr> operands{parse_unary()};
+    std::vector<Operation> operations;
     while (peek_operator("*") || peek_operator("/")) {
-      const std::string op = next().text;
-      left = make_operator(NodeKind::Binary, op, {left, parse_unary()});
+      operations.push_back(next().text == "*" ? Operation::Multiply : Operation::Divide);
+      operands.push_back(parse_unary());
     }
-    return left;
+    return make_chain(std::move(operands), std::move(operations));
   }
 
   NodePtr parse_unary() {
+    Nesting nesting(*this);
     if (peek_operator("-") || peek_operator("+") || peek_operator("!")) {
       const std::string op = next().text;
       NodePtr operand = parse_unary();
@@ -351,7 +433,7 @@ class Parser {
       auto node = std::make_shared<ExpressionNode>();
       node->kind = NodeKind::Variable;
       node->space = VariableSpace::Noise;
-      return node;
+      return count(std::move(node));
     }
     if (name.size() < 2) return nullptr;
     const std::string letters = "xuw";
@@ -375,7 +457,7 @@ class Parser {
     node->kind = NodeKind::Variable;
     node->space = static_cast<VariableSpace>(space);
     node->index = index;
-    return node;
+    return count(std::move(node));
   }
 
   NodePtr parse_call(const Token& name, const FunctionInfo& function) {
@@ -410,7 +492,33 @@ class Parser {
   const std::map<std::string, double>& constants_;
   std::size_t dims_[3];
   bool noise_variable_ = false;  // a density: `z` is the only variable
+  std::size_t depth_ = 0;
+  std::size_t nodes_ = 0;
 };
+
+double evaluate_node(const ExpressionNode& node, const double* x, const double* u, const double* w, double z);
+
+// Left to right, as C evaluates `a - b + c` and `a && b && c` (the logical ones stop early).
+double evaluate_chain(const ExpressionNode& node, const double* x, const double* u, const double* w, double z) {
+  const Operation first = node.chain_operations.front();
+  if (first == Operation::And || first == Operation::Or) {
+    const bool stop_on = first == Operation::Or;
+    for (const auto& child : node.children)
+      if ((evaluate_node(*child, x, u, w, z) != 0.0) == stop_on) return stop_on ? 1.0 : 0.0;
+    return stop_on ? 0.0 : 1.0;
+  }
+  double accumulated = evaluate_node(*node.children[0], x, u, w, z);
+  for (std::size_t i = 1; i < node.children.size(); ++i) {
+    const double operand = evaluate_node(*node.children[i], x, u, w, z);
+    switch (node.chain_operations[i - 1]) {
+      case Operation::Add: accumulated += operand; break;
+      case Operation::Subtract: accumulated -= operand; break;
+      case Operation::Multiply: accumulated *= operand; break;
+      default: accumulated /= operand; break;
+    }
+  }
+  return accumulated;
+}
 
 double evaluate_node(const ExpressionNode& node, const double* x, const double* u, const double* w, double z) {
   switch (node.kind) {
@@ -430,12 +538,9 @@ double evaluate_node(const ExpressionNode& node, const double* x, const double* 
     case NodeKind::Conditional:
       return evaluate_node(*node.children[0], x, u, w, z) != 0.0 ? evaluate_node(*node.children[1], x, u, w, z)
                                                                : evaluate_node(*node.children[2], x, u, w, z);
+    case NodeKind::Chain: return evaluate_chain(node, x, u, w, z);
     case NodeKind::Binary: {
       const double left = evaluate_node(*node.children[0], x, u, w, z);
-      if (node.operation == Operation::And)
-        return (left != 0.0 && evaluate_node(*node.children[1], x, u, w, z) != 0.0) ? 1.0 : 0.0;
-      if (node.operation == Operation::Or)
-        return (left != 0.0 || evaluate_node(*node.children[1], x, u, w, z) != 0.0) ? 1.0 : 0.0;
       const double right = evaluate_node(*node.children[1], x, u, w, z);
       switch (node.operation) {
         case Operation::Add: return left + right;
@@ -507,10 +612,20 @@ std::string to_c_node(const ExpressionNode& node) {
       const std::string right = to_c_node(*node.children[1]);
       const std::string& op = node.op;
       if (op == "^") return "pow(" + left + ", " + right + ")";
-      if (op == "&&" || op == "||")
-        return "((double)((" + left + " != 0.0) " + op + " (" + right + " != 0.0)))";
-      if (op == "+" || op == "-" || op == "*" || op == "/") return "(" + left + " " + op + " " + right + ")";
       return "((double)(" + left + " " + op + " " + right + "))";
+    }
+    case NodeKind::Chain: {
+      // C's operators associate to the left as the Chain does, so no inner parentheses are needed
+      // (and OpenCL compilers' bracket-nesting limits are not approached by long sums).
+      const Operation first = node.chain_operations.front();
+      const bool logical = first == Operation::And || first == Operation::Or;
+      std::string text = logical ? "((double)(" : "(";
+      for (std::size_t i = 0; i < node.children.size(); ++i) {
+        if (i) text += std::string(" ") + chain_symbol(node.chain_operations[i - 1]) + " ";
+        const std::string operand = to_c_node(*node.children[i]);
+        text += logical ? "(" + operand + " != 0.0)" : operand;
+      }
+      return text + (logical ? "))" : ")");
     }
     case NodeKind::Call: {
       const FunctionInfo* function = find_function(node.op);
@@ -525,10 +640,18 @@ std::string to_c_node(const ExpressionNode& node) {
   return "0.0";
 }
 
+void check_length(const std::string& text) {
+  if (text.size() > kMaxExpressionLength)
+    throw ParseError(kMaxExpressionLength + 1, "the expression is " + std::to_string(text.size()) +
+                                                   " characters long, more than the limit of " +
+                                                   std::to_string(kMaxExpressionLength));
+}
+
 }  // namespace
 
 Expression Expression::parse(const std::string& text, const std::map<std::string, double>& constants,
                              std::size_t state_dims, std::size_t input_dims, std::size_t disturbance_dims) {
+  check_length(text);
   Parser parser(text, constants, state_dims, input_dims, disturbance_dims);
   Expression expression;
   expression.root_ = parser.parse_all();
@@ -537,6 +660,7 @@ Expression Expression::parse(const std::string& text, const std::map<std::string
 }
 
 Expression Expression::parse_density(const std::string& text, const std::map<std::string, double>& constants) {
+  check_length(text);
   Parser parser(text, constants, 0, 0, 0, true);
   Expression expression;
   expression.root_ = parser.parse_all();
@@ -574,6 +698,16 @@ VariableUse Expression::variables() const {
   };
   return {indices(seen[int(VariableSpace::State)]), indices(seen[int(VariableSpace::Input)]),
           indices(seen[int(VariableSpace::Disturbance)])};
+}
+
+}  // namespace amytiss
+
+namespace amytiss {
+
+std::string expression_excerpt(const std::string& text) {
+  constexpr std::size_t kShown = 60;
+  if (text.size() <= kShown) return text;
+  return text.substr(0, kShown) + "... (" + std::to_string(text.size()) + " characters)";
 }
 
 }  // namespace amytiss

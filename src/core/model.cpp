@@ -304,7 +304,7 @@ std::vector<Expression> parse_dynamics(const Config& config) {
       expressions.push_back(Expression::parse(config.dynamics[i], config.constants, n, m, p));
     } catch (const ParseError& error) {
       throw ConfigError("dynamics[" + std::to_string(i) + "]",
-                        std::string(error.what()) + " in \"" + config.dynamics[i] + "\"");
+                        std::string(error.what()) + " in \"" + expression_excerpt(config.dynamics[i]) + "\"");
     }
   }
   return expressions;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 
 namespace amytiss {
@@ -107,6 +108,14 @@ ValueSummary summarize_initial_values(const Policy& policy) {
   }
   if (summary.free_cells) summary.mean = sum / double(summary.free_cells);
   return summary;
+}
+
+std::string new_run_id() {
+  std::random_device device;
+  const std::uint64_t id = (std::uint64_t(device()) << 32) ^ std::uint64_t(device());
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(id));
+  return text;
 }
 
 }  // namespace amytiss

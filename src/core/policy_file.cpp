@@ -4,18 +4,124 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
 #include "amytiss/errors.hpp"
+#include "amytiss/version.hpp"
 
 namespace amytiss {
 namespace {
 
 constexpr const char* kFormatName = "amytiss-policy";
-constexpr unsigned kFormatVersion = 1;
+constexpr unsigned kFormatVersion = 2;
+// Chunks of the checksummed arrays hold at most this many bytes (HDF5's limit is 4 GiB).
+constexpr std::uint64_t kChunkBytes = 16u << 20;
+
+// A 64-bit digest of everything the file says (attributes, the configuration text and every
+// array), stored as the attribute content_digest and recomputed by the reader. Fed with 64-bit
+// words, so it does not depend on the machine's byte order.
+class ContentDigest {
+ public:
+  void add(std::uint64_t word) {
+    state_ = (state_ ^ word) * 0x9e3779b97f4a7c15ull;
+    state_ ^= state_ >> 29;
+  }
+  void add(const std::string& text) {
+    add(std::uint64_t(text.size()));
+    for (std::size_t at = 0; at < text.size(); at += 8) {
+      std::uint64_t word = 0;
+      for (std::size_t i = at; i < std::min(text.size(), at + 8); ++i)
+        word |= std::uint64_t(static_cast<unsigned char>(text[i])) << (8 * (i - at));
+      add(word);
+    }
+  }
+  void add(const std::vector<double>& values) {
+    add(std::uint64_t(values.size()));
+    for (double value : values) {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &value, sizeof bits);
+      add(bits);
+    }
+  }
+  template <typename Unsigned>
+  void add(const std::vector<Unsigned>& values) {
+    add(std::uint64_t(values.size()));
+    for (Unsigned value : values) add(std::uint64_t(value));
+  }
+  std::string hex() const {
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(state_));
+    return text;
+  }
+
+ private:
+  std::uint64_t state_ = 0xcbf29ce484222325ull;
+};
+
+// The attributes in the order the digest takes them.
+struct FileAttributes {
+  std::string format;
+  std::uint64_t format_version = 0;
+  std::string config_hash, computed_by, run_id;
+  std::uint64_t engine_version = 0, horizon = 0;
+  std::string spec;
+};
+
+void add_attributes(ContentDigest& digest, const FileAttributes& attributes) {
+  digest.add(attributes.format);
+  digest.add(attributes.format_version);
+  digest.add(attributes.config_hash);
+  digest.add(attributes.computed_by);
+  digest.add(attributes.run_id);
+  digest.add(attributes.engine_version);
+  digest.add(attributes.horizon);
+  digest.add(attributes.spec);
+}
+
+void add_grid(ContentDigest& digest, const Grid& grid) {
+  digest.add(grid.lb());
+  digest.add(grid.eta());
+  digest.add(std::vector<std::uint64_t>(grid.counts().begin(), grid.counts().end()));
+}
+
+std::vector<double> input_points(const Grid& inputs) {
+  std::vector<double> points(inputs.size() * inputs.dims());
+  for (std::size_t flat = 0; flat < inputs.size(); ++flat) inputs.point(flat, points.data() + flat * inputs.dims());
+  return points;
+}
+
+std::string digest_of(const FileAttributes& attributes, const std::string& config_yaml, const Policy& policy) {
+  ContentDigest digest;
+  add_attributes(digest, attributes);
+  digest.add(config_yaml);
+  add_grid(digest, policy.states);
+  add_grid(digest, policy.inputs);
+  digest.add(policy.values);
+  digest.add(policy.input_index);
+  digest.add(input_points(policy.inputs));
+  std::vector<std::uint8_t> roles(policy.roles.size());
+  for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = std::uint8_t(policy.roles[i]);
+  digest.add(roles);
+  return digest.hex();
+}
+
+// Chunk extents for an array of `shape`: whole trailing dimensions while they fit kChunkBytes.
+std::vector<hsize_t> chunk_shape(const std::vector<hsize_t>& shape, std::size_t element_bytes) {
+  std::vector<hsize_t> chunk(shape.size(), 1);
+  std::uint64_t bytes = element_bytes;
+  for (std::size_t dim = shape.size(); dim-- > 0;) {
+    const std::uint64_t fit = std::max<std::uint64_t>(1, kChunkBytes / bytes);
+    chunk[dim] = hsize_t(std::min<std::uint64_t>(shape[dim], fit));
+    bytes *= chunk[dim];
+    if (chunk[dim] < shape[dim]) break;
+  }
+  return chunk;
+}
 
 // HDF5 prints its own error stack to stderr by default; we report through PolicyFileError only.
 // H5Eset_auto is per thread in thread-safe builds, so it is silenced around every operation.
@@ -114,11 +220,19 @@ class Writer {
     Handle space = checked(
         H5Screate_simple(int(shape.size()), shape.empty() ? nullptr : shape.data(), nullptr),
         H5Sclose, name);
-    Handle dataset = checked(H5Dcreate2(file_, name.c_str(), file_type, space.get(), H5P_DEFAULT,
-                                        H5P_DEFAULT, H5P_DEFAULT),
-                             H5Dclose, name);
     hsize_t elements = 1;
     for (hsize_t extent : shape) elements *= extent;
+    // Every non-empty array is chunked with HDF5's Fletcher-32 checksum, which any HDF5 reader
+    // (h5py included) verifies on every read.
+    Handle properties = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, name);
+    if (elements > 0) {
+      const std::vector<hsize_t> chunk = chunk_shape(shape, H5Tget_size(file_type));
+      check(H5Pset_chunk(properties.get(), int(chunk.size()), chunk.data()), name);
+      check(H5Pset_fletcher32(properties.get()), name);
+    }
+    Handle dataset = checked(H5Dcreate2(file_, name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                                        properties.get(), H5P_DEFAULT),
+                             H5Dclose, name);
     // A zero-sized dataset (the input grid of an autonomous system) has nothing to write, and
     // H5Dwrite refuses a null buffer.
     if (elements > 0)
@@ -144,16 +258,30 @@ std::vector<hsize_t> cell_shape(const Grid& states, std::size_t leading) {
   return shape;
 }
 
-void write_contents(hid_t file, const Policy& policy, const Config& config,
-                    const std::string& hash, const std::string& format, unsigned format_version) {
+void write_contents(hid_t file, const Policy& policy, const Config& config, const std::string& hash,
+                    const std::string& format, unsigned format_version, unsigned engine_version) {
+  FileAttributes attributes;
+  attributes.format = format;
+  attributes.format_version = format_version;
+  attributes.config_hash = hash;
+  attributes.computed_by = policy.computed_by;
+  attributes.run_id = policy.run_id;
+  attributes.engine_version = engine_version;
+  attributes.horizon = policy.horizon;
+  attributes.spec = to_string(config.spec.type);
+  const std::string config_yaml = to_yaml(config);
+
   Writer writer(file);
-  writer.string_attribute("format", format);
-  writer.unsigned_attribute("format_version", format_version);
-  writer.string_attribute("config_hash", hash);
-  writer.string_attribute("computed_by", policy.computed_by);
-  writer.unsigned_attribute("horizon", policy.horizon);
-  writer.string_attribute("spec", to_string(config.spec.type));
-  writer.string_dataset("/config", to_yaml(config));
+  writer.string_attribute("format", attributes.format);
+  writer.unsigned_attribute("format_version", attributes.format_version);
+  writer.string_attribute("config_hash", attributes.config_hash);
+  writer.string_attribute("computed_by", attributes.computed_by);
+  writer.string_attribute("run_id", attributes.run_id);
+  writer.unsigned_attribute("engine_version", attributes.engine_version);
+  writer.unsigned_attribute("horizon", attributes.horizon);
+  writer.string_attribute("spec", attributes.spec);
+  writer.string_attribute("content_digest", digest_of(attributes, config_yaml, policy));
+  writer.string_dataset("/config", config_yaml);
   writer.grid("/states", policy.states);
   writer.grid("/inputs", policy.inputs);
 
@@ -162,9 +290,7 @@ void write_contents(hid_t file, const Policy& policy, const Config& config,
   writer.dataset("/input_index", cell_shape(policy.states, policy.horizon), H5T_STD_U32LE,
                  H5T_NATIVE_UINT32, policy.input_index.data());
 
-  std::vector<double> input_values(policy.inputs.size() * policy.inputs.dims());
-  for (std::size_t flat = 0; flat < policy.inputs.size(); ++flat)
-    policy.inputs.point(flat, input_values.data() + flat * policy.inputs.dims());
+  const std::vector<double> input_values = input_points(policy.inputs);
   writer.dataset("/input_values", {hsize_t(policy.inputs.size()), hsize_t(policy.inputs.dims())},
                  H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, input_values.data());
 
@@ -304,9 +430,10 @@ class Reader {
     std::size_t elements = 1;
     for (hsize_t extent : shape) elements *= std::size_t(extent);
     std::vector<T> data(elements);
+    // HDF5 verifies the Fletcher-32 checksum of each chunk here.
     if (elements > 0 &&
         H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
-      corrupt("dataset '" + name + "'");
+      corrupt("dataset '" + name + "' (its checksum does not match or its data is missing)");
     return data;
   }
 
@@ -405,14 +532,19 @@ Policy read_contents(hid_t file, const std::string& path, LoadedPolicy& loaded) 
                 std::to_string(kFormatVersion) + ")");
 
   Policy policy;
-  loaded.config_hash = reader.string_attribute("config_hash");
-  policy.config_hash = loaded.config_hash;
-  policy.computed_by = reader.string_attribute("computed_by");
-  const std::uint64_t horizon = reader.unsigned_attribute("horizon");
-  if (horizon == 0 || horizon > std::numeric_limits<unsigned>::max())
-    reader.fail("horizon " + std::to_string(horizon) + " is out of range (expected >= 1)");
-  policy.horizon = unsigned(horizon);
-  reader.string_attribute("spec");
+  FileAttributes attributes;
+  attributes.format = format;
+  attributes.format_version = version;
+  attributes.config_hash = loaded.config_hash = policy.config_hash = reader.string_attribute("config_hash");
+  attributes.computed_by = policy.computed_by = reader.string_attribute("computed_by");
+  attributes.run_id = policy.run_id = reader.string_attribute("run_id");
+  attributes.engine_version = loaded.engine_version = reader.unsigned_attribute("engine_version");
+  attributes.horizon = reader.unsigned_attribute("horizon");
+  if (attributes.horizon == 0 || attributes.horizon > std::numeric_limits<unsigned>::max())
+    reader.fail("horizon " + std::to_string(attributes.horizon) + " is out of range (expected >= 1)");
+  policy.horizon = unsigned(attributes.horizon);
+  attributes.spec = reader.string_attribute("spec");
+  const std::string stored_digest = reader.string_attribute("content_digest");
   loaded.config_yaml = reader.string_dataset("/config");
 
   policy.states = reader.grid("/states");
@@ -459,6 +591,10 @@ Policy read_contents(hid_t file, const std::string& path, LoadedPolicy& loaded) 
                   ", expected 0 (free), 1 (fixed zero) or 2 (fixed one)");
     policy.roles.push_back(CellRole(roles[i]));
   }
+  const std::string digest = digest_of(attributes, loaded.config_yaml, policy);
+  if (digest != stored_digest)
+    reader.fail("corrupt: its contents give the digest " + digest + " but the file records " + stored_digest +
+                " (modified or damaged after it was written)");
   return policy;
 }
 
@@ -471,7 +607,7 @@ void write_policy_file(const std::string& path, const Policy& policy, const Conf
 
 namespace detail {
 void write_policy_file_as(const std::string& path, const Policy& policy, const Config& config,
-                          const std::string& format, unsigned format_version) {
+                          const std::string& format, unsigned format_version, unsigned engine_version) {
   check_policy_consistent(policy);
   const std::string hash = config_hash(config);
   if (!policy.config_hash.empty() && policy.config_hash != hash)
@@ -482,7 +618,7 @@ void write_policy_file_as(const std::string& path, const Policy& policy, const C
   try {
     Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
     if (!file.valid()) throw PolicyFileError("cannot create " + temporary);
-    write_contents(file.get(), policy, config, hash, format, format_version);
+    write_contents(file.get(), policy, config, hash, format, format_version, engine_version);
     if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) throw PolicyFileError("cannot flush");
   } catch (const PolicyFileError& error) {
     std::remove(temporary.c_str());
@@ -525,6 +661,10 @@ LoadedPolicy read_policy_file_for(const std::string& path, const Config& config)
     throw PolicyFileError("policy file " + path + " was made from another configuration (its " +
                           "config_hash is " + loaded.config_hash + ", this configuration's is " +
                           expected + ")");
+  if (loaded.engine_version != kEngineVersion)
+    throw PolicyFileError("policy file " + path + " was computed by engine version " +
+                          std::to_string(loaded.engine_version) + "; this build computes version " +
+                          std::to_string(kEngineVersion) + ", whose results may differ");
   return loaded;
 }
 

@@ -6,9 +6,16 @@
 
 namespace amytiss_ros {
 
-const std::vector<std::string> kNodeParameterKeys = {"policy_file", "device", "synthesize_on_start"};
+const std::vector<std::string> kNodeParameterKeys = {"policy_file", "device", "synthesize_on_start",
+                                                     "heartbeat_period_s", "diagnostic_period"};
 
-YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path) {
+YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path, std::size_t depth) {
+  // The schema nests three levels; a deeper tree is refused before it can exhaust the stack.
+  constexpr std::size_t kMaxDepth = 32;
+  if (depth > kMaxDepth)
+    throw amytiss::ConfigError(path, "got parameters nested deeper than " + std::to_string(kMaxDepth) +
+                                         " levels, expected the configuration schema (example: "
+                                         "states: {lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]})");
   switch (value.getType()) {
     case XmlRpc::XmlRpcValue::TypeBoolean:
       return YAML::Node(static_cast<bool>(value));
@@ -21,14 +28,14 @@ YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path)
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node sequence(YAML::NodeType::Sequence);
       for (int i = 0; i < value.size(); ++i)
-        sequence.push_back(yaml_from_xmlrpc(value[i], path + "[" + std::to_string(i) + "]"));
+        sequence.push_back(yaml_from_xmlrpc(value[i], path + "[" + std::to_string(i) + "]", depth + 1));
       return sequence;
     }
     case XmlRpc::XmlRpcValue::TypeStruct: {
       YAML::Node map(YAML::NodeType::Map);
       for (auto& member : value)
         map[member.first] =
-            yaml_from_xmlrpc(member.second, path.empty() ? member.first : path + "." + member.first);
+            yaml_from_xmlrpc(member.second, path.empty() ? member.first : path + "." + member.first, depth + 1);
       return map;
     }
     case XmlRpc::XmlRpcValue::TypeInvalid:

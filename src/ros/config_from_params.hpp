@@ -17,8 +17,8 @@ extern const std::vector<std::string> kNodeParameterKeys;
 
 /// The XmlRpc tree as YAML: struct -> map, array -> sequence, int/double/bool/string -> scalars
 /// (doubles with full precision). Throws amytiss::ConfigError (key "<path>") for XmlRpc types
-/// with no YAML counterpart (date-time, base64).
-YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path = "");
+/// with no YAML counterpart (date-time, base64) and for trees nested deeper than 32 levels.
+YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path = "", std::size_t depth = 0);
 
 /// Converts the private-namespace tree (a struct) to a validated configuration: drops
 /// kNodeParameterKeys, applies `device_override` to compute.device when it is not empty

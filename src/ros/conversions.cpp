@@ -13,13 +13,13 @@ namespace {
 // input and `probability` V_k of the state's cell; otherwise `input` is empty, `probability` 0
 // and `message` says why.
 bool answer_state(const amytiss::Policy* policy, const std::vector<double>& state, unsigned time_step,
-                  const std::string& no_policy_reason, std::vector<double>& input, double& probability,
+                  const std::string& server_notice, std::vector<double>& input, double& probability,
                   std::string& message) {
   probability = 0.0;
   message.clear();
   if (policy == nullptr) {
     input.clear();
-    message = "no policy yet: " + no_policy_reason;
+    message = "no policy yet: " + server_notice;
     return false;
   }
   input.resize(policy->inputs.dims());
@@ -31,29 +31,38 @@ bool answer_state(const amytiss::Policy* policy, const std::vector<double>& stat
     return false;
   }
   probability = value;
+  message = server_notice;
   return true;
+}
+
+template <typename Answer>
+void name_policy(const amytiss::Policy* policy, Answer& answer) {
+  answer.config_hash = policy ? policy->config_hash : std::string();
+  answer.run_id = policy ? policy->run_id : std::string();
 }
 
 }  // namespace
 
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
-                             unsigned time_step, const std::string& no_policy_reason,
-                             amytiss::GetInput::Response& response) {
-  response.success = answer_state(policy, state, time_step, no_policy_reason, response.input, response.probability,
+                             unsigned time_step, const std::string& server_notice,
+                             amytiss_msgs::GetInput::Response& response) {
+  response.success = answer_state(policy, state, time_step, server_notice, response.input, response.probability,
                                   response.message);
+  name_policy(policy, response);
 }
 
-void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
-                        const std::string& no_policy_reason, amytiss::InputCommand& command) {
+void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::StateStamped& state,
+                        const std::string& server_notice, amytiss_msgs::InputCommand& command) {
   command.header.stamp = state.header.stamp;
   command.header.frame_id = state.header.frame_id;
   command.time_step = state.time_step;
-  command.valid = answer_state(policy, state.state, state.time_step, no_policy_reason, command.input,
+  command.valid = answer_state(policy, state.state, state.time_step, server_notice, command.input,
                                command.probability, command.message);
+  name_policy(policy, command);
 }
 
-amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
-  amytiss::SynthesizeFeedback feedback;
+amytiss_msgs::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
+  amytiss_msgs::SynthesizeFeedback feedback;
   feedback.phase = amytiss::to_string(progress.phase);
   feedback.percent = progress.percent();
   feedback.steps_done = progress.steps_done;

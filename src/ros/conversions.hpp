@@ -2,11 +2,11 @@
 // Conversions between core types and amytiss messages. Pure functions: no node, no master.
 #include <string>
 
-#include <amytiss/GetInput.h>
-#include <amytiss/InputCommand.h>
-#include <amytiss/PolicyStatus.h>
-#include <amytiss/StateStamped.h>
-#include <amytiss/SynthesizeFeedback.h>
+#include <amytiss_msgs/GetInput.h>
+#include <amytiss_msgs/InputCommand.h>
+#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss_msgs/StateStamped.h>
+#include <amytiss_msgs/SynthesizeFeedback.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "amytiss/config.hpp"
@@ -17,20 +17,22 @@
 namespace amytiss_ros {
 
 /// Answers a GetInput request from `policy` (nullptr: no policy loaded yet, answered with
-/// success false and "no policy yet: " + no_policy_reason). On success `input` has the policy's
-/// input dimensions and `probability` is V_k of the state's cell; otherwise success is false,
-/// `message` is Policy::describe()'s sentence, `input` is empty and probability 0.
-/// Allocation: only the response's input vector (reuses its capacity).
+/// success false and "no policy yet: " + server_notice). On success `input` has the policy's
+/// input dimensions, `probability` is V_k of the state's cell and `message` is server_notice (a
+/// warning such as "synthesizer not running since ...", usually empty); otherwise success is
+/// false, `message` is Policy::describe()'s sentence, `input` is empty and probability 0.
+/// config_hash and run_id name the answering policy (empty without one).
+/// Allocation: only the response's vector and strings (they reuse their capacity).
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
-                             unsigned time_step, const std::string& no_policy_reason,
-                             amytiss::GetInput::Response& response);
+                             unsigned time_step, const std::string& server_notice,
+                             amytiss_msgs::GetInput::Response& response);
 
 /// The same for the closed loop: answers `state` into `command` (header and time_step copied).
-void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
-                        const std::string& no_policy_reason, amytiss::InputCommand& command);
+void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::StateStamped& state,
+                        const std::string& server_notice, amytiss_msgs::InputCommand& command);
 
 /// Action feedback from engine progress.
-amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
+amytiss_msgs::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
 
 /// "synthesis 42% (step 7/16) on reference, about 3.1 s left" for status and logs.
 std::string describe_progress(const amytiss::Progress& progress);

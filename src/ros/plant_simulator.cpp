@@ -1,13 +1,18 @@
 #include "plant_simulator.hpp"
 
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
-#include <amytiss/StateStamped.h>
+#include <amytiss_msgs/StateStamped.h>
 #include <visualization_msgs/Marker.h>
 
 #include "amytiss/policy_file.hpp"
@@ -20,22 +25,22 @@ namespace amytiss_ros {
 
 PlantSimulatorNode::PlantSimulatorNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle)
     : public_handle_(public_handle), private_handle_(private_handle) {
-  state_publisher_ = public_handle_.advertise<amytiss::StateStamped>("state", 10);
-  summary_publisher_ = public_handle_.advertise<amytiss::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
+  state_publisher_ = public_handle_.advertise<amytiss_msgs::StateStamped>("state", 10);
+  summary_publisher_ = public_handle_.advertise<amytiss_msgs::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
   car_publisher_ = public_handle_.advertise<visualization_msgs::Marker>("car_marker", 10);
   status_subscriber_ = public_handle_.subscribe("status", 10, &PlantSimulatorNode::on_status, this);
   command_subscriber_ = public_handle_.subscribe("command", 10, &PlantSimulatorNode::on_command, this,
                                                  ros::TransportHints().tcpNoDelay());
 }
 
-void PlantSimulatorNode::on_status(const amytiss::PolicyStatus::ConstPtr& status) {
+void PlantSimulatorNode::on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status) {
   if (!status->ready) return;
   std::lock_guard<std::mutex> lock(mutex_);
   ready_status_ = status;
   changed_.notify_all();
 }
 
-void PlantSimulatorNode::on_command(const amytiss::InputCommand::ConstPtr& command) {
+void PlantSimulatorNode::on_command(const amytiss_msgs::InputCommand::ConstPtr& command) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_command_ = command;
   changed_.notify_all();
@@ -67,6 +72,23 @@ std::string csv_row(int episode, unsigned step, const std::vector<double>& state
   return row.str();
 }
 
+// Runs a program with these arguments (no shell, so names and paths need no quoting) and waits.
+// Returns "" on exit status 0, otherwise what went wrong.
+std::string run_program(const std::vector<std::string>& arguments) {
+  std::vector<char*> argv;
+  for (const auto& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  pid_t child = 0;
+  const int spawn_error = posix_spawnp(&child, argv[0], nullptr, nullptr, argv.data(), environ);
+  if (spawn_error != 0) return std::string("cannot start ") + arguments[0] + ": " + std::strerror(spawn_error);
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0)
+    if (errno != EINTR) return std::string("cannot wait for ") + arguments[0] + ": " + std::strerror(errno);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+  return WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
+                           : "killed by signal " + std::to_string(WTERMSIG(status));
+}
+
 }  // namespace
 
 int PlantSimulatorNode::run() {
@@ -82,7 +104,8 @@ int PlantSimulatorNode::run() {
   private_handle_.param("policy_timeout_s", policy_timeout_s, 600.0);
   private_handle_.param<std::string>("output_dir", output_dir, "");
   private_handle_.param<std::string>("plot_script", plot_script, "");
-  private_handle_.param<std::string>("python", python, "/usr/bin/python3");
+  // The interpreter catkin was configured with (the one catkin_install_python puts in shebangs).
+  private_handle_.param<std::string>("python", python, AMYTISS_PYTHON_EXECUTABLE);
   private_handle_.param("exit_when_done", exit_when_done, true);
   std::string scene_file;
   double playback_period_s = 0.0;
@@ -92,7 +115,7 @@ int PlantSimulatorNode::run() {
     output_dir = std::filesystem::path(default_policy_path("x")).parent_path().string() + "/episodes";
 
   ROS_INFO("plant simulator: waiting for a policy on %s", status_subscriber_.getTopic().c_str());
-  amytiss::PolicyStatus::ConstPtr status;
+  amytiss_msgs::PolicyStatus::ConstPtr status;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, std::chrono::duration<double>(policy_timeout_s),
@@ -148,7 +171,7 @@ int PlantSimulatorNode::run() {
   csv << ",probability,success\n";
   csv.precision(10);
 
-  amytiss::EpisodeSummary summary;
+  amytiss_msgs::EpisodeSummary summary;
   summary.initial_state = initial_state;
   summary.predicted_probability = predicted;
   ros::Time last_stamp;
@@ -165,12 +188,12 @@ int PlantSimulatorNode::run() {
         rows.push_back(csv_row(episode, step, state, {}, policy.inputs.dims(), std::nan("")));
         break;
       }
-      amytiss::InputCommand::ConstPtr command;
+      amytiss_msgs::InputCommand::ConstPtr command;
       // The server loads the policy after the status says ready: until then it answers "no policy
       // yet", and the state is sent again (bounded by policy_timeout_s).
       const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(policy_timeout_s);
       for (;;) {
-        amytiss::StateStamped message;
+        amytiss_msgs::StateStamped message;
         message.header.stamp = ros::Time::now();
         if (message.header.stamp <= last_stamp) message.header.stamp = last_stamp + ros::Duration(0, 1);
         last_stamp = message.header.stamp;
@@ -227,19 +250,24 @@ int PlantSimulatorNode::run() {
   if (!plot_script.empty()) {
     summary.trajectories_png = base + "_trajectories.png";
     summary.values_png = base + "_values.png";
-    std::string command = python + " '" + plot_script + "' --csv '" + csv_path + "' --policy '" +
-                                status->policy_file + "' --initial-state '" + join(initial_state) +
-                                "' --trajectories '" + summary.trajectories_png + "' --values '" +
-                                summary.values_png + "'";
-    if (outline)
-      command += " --footprint '" + join({outline->length, outline->width, outline->rear_to_reference,
-                                          double(outline->x_index), double(outline->y_index),
-                                          double(outline->yaw_index)}) + "'";
-    if (!scene_file.empty()) command += " --scene '" + scene_file + "'";
-    if (std::system(command.c_str()) == 0) {
+    std::vector<std::string> arguments = {python, plot_script, "--csv", csv_path, "--policy", status->policy_file,
+                                          "--initial-state", join(initial_state), "--trajectories",
+                                          summary.trajectories_png, "--values", summary.values_png};
+    if (outline) {
+      arguments.push_back("--footprint");
+      arguments.push_back(join({outline->length, outline->width, outline->rear_to_reference,
+                                double(outline->x_index), double(outline->y_index), double(outline->yaw_index)}));
+    }
+    if (!scene_file.empty()) {
+      arguments.push_back("--scene");
+      arguments.push_back(scene_file);
+    }
+    const std::string failure = run_program(arguments);
+    if (failure.empty()) {
       ROS_INFO("pictures: %s and %s", summary.trajectories_png.c_str(), summary.values_png.c_str());
     } else {
-      ROS_WARN("the plot script failed (%s); trajectories are in %s", command.c_str(), csv_path.c_str());
+      ROS_WARN("the plot script %s failed (%s); trajectories are in %s", plot_script.c_str(), failure.c_str(),
+               csv_path.c_str());
       summary.trajectories_png.clear();
       summary.values_png.clear();
     }

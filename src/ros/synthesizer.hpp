@@ -2,13 +2,16 @@
 // The synthesizer node's logic (the node's main() only constructs it and spins).
 //
 // Interface (relative to the public node handle, /amytiss in the launch files):
-//   action  synthesize (amytiss/Synthesize): re-read the private parameters (or the goal's YAML)
+//   action  synthesize (amytiss_msgs/Synthesize): re-read the private parameters (or the goal's YAML)
 //           and synthesize; cancel the goal to stop; feedback per time step.
-//   topic   status (amytiss/PolicyStatus, latched): progress, errors, and each new policy.
+//   topic   status (amytiss_msgs/PolicyStatus, latched): progress, errors, and each new policy;
+//           republished every ~heartbeat_period_s as a heartbeat.
+//   topic   /diagnostics (diagnostic_updater): synthesis state, device, the ready policy.
 // Private parameters: the configuration schema (docs/configuration.md), plus
 //   ~policy_file (string, default $ROS_HOME/amytiss/<name>.h5, ROS_HOME defaults to ~/.ros),
 //   ~device (string, overrides compute.device when not empty: auto | cpu | gpu | reference),
-//   ~synthesize_on_start (bool, default true).
+//   ~synthesize_on_start (bool, default true),
+//   ~heartbeat_period_s (double, default 1): period of the status heartbeat.
 #include <atomic>
 #include <functional>
 #include <mutex>
@@ -16,8 +19,9 @@
 #include <thread>
 
 #include <actionlib/server/simple_action_server.h>
-#include <amytiss/PolicyStatus.h>
-#include <amytiss/SynthesizeAction.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss_msgs/SynthesizeAction.h>
 #include <ros/ros.h>
 
 #include "amytiss/config.hpp"
@@ -54,16 +58,19 @@ class SynthesizerNode {
               const ProgressSink& on_progress);
   Outcome run_from_source(const std::function<amytiss::Config()>& read_config, bool force,
                           const CancelCheck& cancelled, const ProgressSink& on_progress);
-  void execute_goal(const amytiss::SynthesizeGoalConstPtr& goal);
+  void execute_goal(const amytiss_msgs::SynthesizeGoalConstPtr& goal);
   /// Edits the status under its lock, stamps it and publishes it.
-  void update_status(const std::function<void(amytiss::PolicyStatus&)>& edit);
+  void update_status(const std::function<void(amytiss_msgs::PolicyStatus&)>& edit);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& diagnostic);
 
   ros::NodeHandle public_handle_, private_handle_;
-  actionlib::SimpleActionServer<amytiss::SynthesizeAction> action_server_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer heartbeat_timer_;
+  actionlib::SimpleActionServer<amytiss_msgs::SynthesizeAction> action_server_;
   ros::Publisher status_publisher_;
   std::mutex job_mutex_;  // one synthesis at a time
   std::mutex status_mutex_;
-  amytiss::PolicyStatus status_;
+  amytiss_msgs::PolicyStatus status_;
   std::atomic<bool> cancel_startup_job_{false};
   std::thread startup_thread_;
 };

@@ -181,16 +181,20 @@ TEST_F(CliTest, PythonH5pyOpensTheFileWithTheDocumentedLayout) {
       "/usr/bin/python3 " + quote(kSourceDir + "/scripts/inspect_policy.py") + " tiny.h5");
   ASSERT_EQ(0, result.exit_code) << result.out << result.err;
   EXPECT_CONTAINS(result.out, "attribute format = amytiss-policy");
-  EXPECT_CONTAINS(result.out, "attribute format_version = 1");
+  EXPECT_CONTAINS(result.out, "attribute format_version = 2");
+  EXPECT_CONTAINS(result.out, "attribute engine_version = 1");
+  EXPECT_CONTAINS(result.out, "attribute run_id = ");
+  EXPECT_CONTAINS(result.out, "attribute content_digest = ");
   EXPECT_CONTAINS(result.out,
                   "attribute config_hash = " + config_hash(load_config_file(kTinyConfig)));
   EXPECT_CONTAINS(result.out, "attribute horizon = 4");
   EXPECT_CONTAINS(result.out, "attribute spec = reach_avoid");
   EXPECT_CONTAINS(result.out, "dataset /config string ()");
-  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9)");
-  EXPECT_CONTAINS(result.out, "dataset /input_index uint32 (4, 9, 9)");
-  EXPECT_CONTAINS(result.out, "dataset /input_values float64 (9, 2)");
-  EXPECT_CONTAINS(result.out, "dataset /roles uint8 (9, 9)");
+  // Every array carries HDF5's Fletcher-32 checksum, which h5py verifies too.
+  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9) fletcher32");
+  EXPECT_CONTAINS(result.out, "dataset /input_index uint32 (4, 9, 9) fletcher32");
+  EXPECT_CONTAINS(result.out, "dataset /input_values float64 (9, 2) fletcher32");
+  EXPECT_CONTAINS(result.out, "dataset /roles uint8 (9, 9) fletcher32");
   for (const char* grid : {"states", "inputs"}) {
     EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/lb float64 (2,)");
     EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/eta float64 (2,)");

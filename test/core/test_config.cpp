@@ -118,6 +118,8 @@ TEST(Config, WrongTypes) {
   root = base();
   root["spec"]["horizon"] = -3;
   expect_error(root, "spec.horizon", "got -3");
+  root["spec"]["horizon"] = 4294967295u;
+  expect_error(root, "spec.horizon", "got 4294967295, expected an integer >= 1 and <= 1000000000");
 }
 
 TEST(Config, GridErrors) {

@@ -189,8 +189,8 @@ TEST(Expression, AutonomousSystemHasNoInputs) {
 
 TEST(Expression, ToCText) {
   const auto c = [](const std::string& text) { return Expression::parse(text, {{"tau", 10.0}}, 2, 2, 1).to_c(); };
-  EXPECT_EQ(c("x0 + tau*u0*cos(u1)"), "(x[0] + ((10.0 * u[0]) * cos(u[1])))");
-  EXPECT_EQ(c("abs(x1) + min(x0, 1) + max(w0, 2)"), "((fabs(x[1]) + fmin(x[0], 1.0)) + fmax(w[0], 2.0))");
+  EXPECT_EQ(c("x0 + tau*u0*cos(u1)"), "(x[0] + (10.0 * u[0] * cos(u[1])))");
+  EXPECT_EQ(c("abs(x1) + min(x0, 1) + max(w0, 2)"), "(fabs(x[1]) + fmin(x[0], 1.0) + fmax(w[0], 2.0))");
   EXPECT_EQ(c("x0^2"), "pow(x[0], 2.0)");
   EXPECT_EQ(c("if(x0 < 1, 2, 3)"), "((((double)(x[0] < 1.0)) != 0.0) ? 2.0 : 3.0)");
   // The shortest text that reads back to the same double.

@@ -19,6 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr unsigned kFormatVersion = 2;  // the version this build writes
+
 Config tiny_config() {
   Config config;
   config.name = "policy_file_test";
@@ -48,6 +50,7 @@ Policy tiny_policy(const Config& config) {
     policy.roles.push_back(CellRole(cell % 3));
   policy.computed_by = "hand-made (test)";
   policy.config_hash = config_hash(config);
+  policy.run_id = "0123456789abcdef";
   return policy;
 }
 
@@ -94,6 +97,7 @@ void expect_same_policy(const Policy& expected, const Policy& actual) {
   EXPECT_EQ(expected.roles, actual.roles);
   EXPECT_EQ(expected.computed_by, actual.computed_by);
   EXPECT_EQ(expected.config_hash, actual.config_hash);
+  EXPECT_EQ(expected.run_id, actual.run_id);
 }
 
 TEST_F(PolicyFileTest, RoundTripGivesAnIdenticalPolicy) {
@@ -191,9 +195,9 @@ TEST_F(PolicyFileTest, RefusesAnotherFormat) {
 
 TEST_F(PolicyFileTest, RefusesAnotherFormatVersion) {
   const Config config = tiny_config();
-  detail::write_policy_file_as(path("p.h5"), tiny_policy(config), config, "amytiss-policy", 2);
+  detail::write_policy_file_as(path("p.h5"), tiny_policy(config), config, "amytiss-policy", 1);
   const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
-  EXPECT_NE(std::string::npos, message.find("format_version 2 is not supported")) << message;
+  EXPECT_NE(std::string::npos, message.find("format_version 1 is not supported")) << message;
 }
 
 TEST_F(PolicyFileTest, RefusesValuesOutsideTheUnitIntervalOrNaN) {
@@ -202,7 +206,7 @@ TEST_F(PolicyFileTest, RefusesValuesOutsideTheUnitIntervalOrNaN) {
     Policy policy = tiny_policy(config);
     policy.values[7] = bad;
     EXPECT_THROW(write_policy_file(path("p.h5"), policy, config), PolicyFileError);
-    detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", 1);
+    detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", kFormatVersion);
     const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
     EXPECT_NE(std::string::npos, message.find("'/values' element 7")) << message;
     EXPECT_NE(std::string::npos, message.find("[0, 1]")) << message;
@@ -214,7 +218,7 @@ TEST_F(PolicyFileTest, RefusesAnInputIndexOutOfRange) {
   Policy policy = tiny_policy(config);
   policy.input_index[4] = 3;  // the input grid has 3 points
   EXPECT_THROW(write_policy_file(path("p.h5"), policy, config), PolicyFileError);
-  detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", 1);
+  detail::write_policy_file_as(path("p.h5"), policy, config, "amytiss-policy", kFormatVersion);
   const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
   EXPECT_NE(std::string::npos, message.find("'/input_index' element 4 is 3")) << message;
 }
@@ -270,6 +274,112 @@ TEST_F(PolicyFileTest, RefusesAPolicyOfAnotherConfigurationAtWriteTime) {
   const std::string message = refusal([&] { write_policy_file(path("p.h5"), policy, config); });
   EXPECT_NE(std::string::npos, message.find("0123456789abcdef")) << message;
   EXPECT_TRUE(fs::is_empty(directory_));
+}
+
+// ---------------------------------------------------------------- integrity (checksums)
+
+std::string file_bytes(const std::string& file_path) {
+  std::ifstream file(file_path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+template <typename T>
+std::string bytes_of(const std::vector<T>& values, std::size_t count) {
+  return std::string(reinterpret_cast<const char*>(values.data()), count * sizeof(T));
+}
+
+// Where `pattern` first occurs in the file (the start of an array whose first elements it is;
+// the hand-made arrays repeat themselves, so later occurrences lie inside the same array).
+std::size_t offset_of(const std::string& file_path, const std::string& pattern) {
+  const std::size_t at = file_bytes(file_path).find(pattern);
+  EXPECT_NE(std::string::npos, at) << "pattern not found";
+  return at == std::string::npos ? 0 : at;
+}
+
+void overwrite(const std::string& file_path, std::size_t offset, const std::string& bytes) {
+  std::fstream file(file_path, std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(std::streamoff(offset));
+  file.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+void flip_bit(const std::string& file_path, std::size_t offset) {
+  std::string byte = file_bytes(file_path).substr(offset, 1);
+  byte[0] = char(byte[0] ^ 0x10);
+  overwrite(file_path, offset, byte);
+}
+
+TEST_F(PolicyFileTest, ZeroedValuesAreRefused) {
+  const Config config = tiny_config();
+  const Policy policy = tiny_policy(config);
+  write_policy_file(path("p.h5"), policy, config);
+  // Zeros are valid probabilities: only the checksum can tell.
+  const std::size_t at = offset_of(path("p.h5"), bytes_of(policy.values, 8));
+  overwrite(path("p.h5"), at, std::string(policy.values.size() * sizeof(double) / 2, '\0'));
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("'/values' (its checksum does not match")) << message;
+}
+
+TEST_F(PolicyFileTest, ZeroedInputIndicesAreRefused) {
+  const Config config = tiny_config();
+  const Policy policy = tiny_policy(config);
+  write_policy_file(path("p.h5"), policy, config);
+  const std::size_t at = offset_of(path("p.h5"), bytes_of(policy.input_index, 12));
+  overwrite(path("p.h5"), at, std::string(policy.input_index.size() * sizeof(std::uint32_t), '\0'));
+  const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+  EXPECT_NE(std::string::npos, message.find("'/input_index' (its checksum does not match")) << message;
+}
+
+TEST_F(PolicyFileTest, OneFlippedBitInAnyArrayIsRefused) {
+  const Config config = tiny_config();
+  const Policy policy = tiny_policy(config);
+  std::vector<std::uint8_t> roles;
+  for (CellRole role : policy.roles) roles.push_back(std::uint8_t(role));
+  const std::vector<std::pair<std::string, std::string>> arrays = {
+      {"/values", bytes_of(policy.values, 8)},
+      {"/input_index", bytes_of(policy.input_index, 12)},
+      {"/roles", bytes_of(roles, roles.size())},
+      {"/states/lb", bytes_of(policy.states.lb(), 2)}};
+  for (const auto& [name, pattern] : arrays) {
+    write_policy_file(path("p.h5"), policy, config);
+    flip_bit(path("p.h5"), offset_of(path("p.h5"), pattern) + pattern.size() / 2);
+    const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+    EXPECT_NE(std::string::npos, message.find("'" + name + "' (its checksum does not match")) << message;
+  }
+}
+
+TEST_F(PolicyFileTest, AChangedConfigurationTextOrAttributeIsRefusedByTheDigest) {
+  const Config config = tiny_config();
+  const Policy policy = tiny_policy(config);
+  for (const std::string text : {std::string("name: \"policy_file_test\""), std::string("hand-made (test)"),
+                                 std::string("0123456789abcdef")}) {
+    write_policy_file(path("p.h5"), policy, config);
+    flip_bit(path("p.h5"), offset_of(path("p.h5"), text) + text.size() - 2);
+    const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+    EXPECT_NE(std::string::npos, message.find("corrupt: its contents give the digest")) << text << ": " << message;
+  }
+}
+
+TEST_F(PolicyFileTest, TruncationAnywhereIsRefused) {
+  const Config config = tiny_config();
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  const std::uintmax_t size = fs::file_size(path("p.h5"));
+  for (std::uintmax_t kept : {size / 10, size / 2, size * 9 / 10, size - 1}) {
+    write_policy_file(path("p.h5"), tiny_policy(config), config);
+    fs::resize_file(path("p.h5"), kept);
+    const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
+    EXPECT_NE(std::string::npos, message.find("truncated or corrupt")) << kept << ": " << message;
+  }
+}
+
+TEST_F(PolicyFileTest, ReuseNeedsThisEngineVersion) {
+  const Config config = tiny_config();
+  detail::write_policy_file_as(path("p.h5"), tiny_policy(config), config, "amytiss-policy", kFormatVersion,
+                               kEngineVersion + 1);
+  EXPECT_EQ(kEngineVersion + 1, read_policy_file(path("p.h5")).engine_version);
+  const std::string message = refusal([&] { read_policy_file_for(path("p.h5"), config); });
+  EXPECT_NE(std::string::npos, message.find("engine version " + std::to_string(kEngineVersion + 1))) << message;
+  write_policy_file(path("p.h5"), tiny_policy(config), config);
+  EXPECT_EQ(kEngineVersion, read_policy_file_for(path("p.h5"), config).engine_version);
 }
 
 }  // namespace

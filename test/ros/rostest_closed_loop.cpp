@@ -6,7 +6,7 @@
 #include <string>
 #include <mutex>
 
-#include <amytiss/EpisodeSummary.h>
+#include <amytiss_msgs/EpisodeSummary.h>
 
 #include "rostest_support.hpp"
 
@@ -24,9 +24,9 @@ constexpr double kMinimumTurnDegrees = 45.0;
 TEST(ClosedLoop, SteeringCarReachesTheTargetConsistentWithV0) {
   ros::NodeHandle handle;
   std::mutex mutex;
-  amytiss::EpisodeSummary::ConstPtr summary;
-  ros::Subscriber subscriber = handle.subscribe<amytiss::EpisodeSummary>(
-      "/amytiss/episode_summary", 1, [&](const amytiss::EpisodeSummary::ConstPtr& message) {
+  amytiss_msgs::EpisodeSummary::ConstPtr summary;
+  ros::Subscriber subscriber = handle.subscribe<amytiss_msgs::EpisodeSummary>(
+      "/amytiss/episode_summary", 1, [&](const amytiss_msgs::EpisodeSummary::ConstPtr& message) {
         std::lock_guard<std::mutex> lock(mutex);
         summary = message;
       });
@@ -64,12 +64,4 @@ TEST(ClosedLoop, SteeringCarReachesTheTargetConsistentWithV0) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_closed_loop_test");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_closed_loop_test", 1); }

@@ -3,72 +3,40 @@
 #include <thread>
 
 #include <actionlib/client/simple_action_client.h>
-#include <amytiss/GetInput.h>
-#include <amytiss/SynthesizeAction.h>
+#include <amytiss_msgs/GetInput.h>
+#include <amytiss_msgs/SynthesizeAction.h>
 
 #include "amytiss/policy_file.hpp"
-#include "rostest_support.hpp"
+#include "rostest_fixture.hpp"
 
 namespace {
 
-constexpr double kActionWaitSeconds = 60.0;
 const std::string kSynthesizer = "/amytiss/synthesizer";
-// A configuration big enough (about 0.1 s per step on the reference engine, 40 steps) to be
-// cancelled while it runs.
-const char* kSlowConfig = R"YAML(
-name: slow_for_cancel
-states:  {lb: [-5, -5], ub: [5, 5], eta: [0.125, 0.125]}
-inputs:  {lb: [0, -3.2], ub: [1, 3.2], eta: [0.5, 0.4]}
-dynamics: ["x0 + u0*cos(u1)", "x1 + u0*sin(u1)"]
-noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncation: cutting_probability, cutting_probability: 1.0e-4}
-spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
-)YAML";
-
-using Client = actionlib::SimpleActionClient<amytiss::SynthesizeAction>;
-
-class ResynthesisTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
-    client_ = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/false);
-    ASSERT_TRUE(action_.waitForServer(ros::Duration(amytiss_test::kServiceWaitSeconds)));
-    ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready && !s.synthesizing; },
-                                 amytiss_test::kPolicyWaitSeconds))
-        << status_.latest().message;
-    ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
-  }
-  amytiss::GetInput::Response call(const std::vector<double>& state, unsigned step) {
-    amytiss::GetInput service;
-    service.request.state = state;
-    service.request.time_step = step;
-    EXPECT_TRUE(client_.call(service));
-    return service.response;
-  }
-  amytiss::SynthesizeResult run_goal(const amytiss::SynthesizeGoal& goal) {
-    action_.sendGoal(goal);
-    EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
-    return *action_.getResult();
-  }
-
-  ros::NodeHandle handle_;
-  amytiss_test::StatusWatcher status_{handle_};
-  ros::ServiceClient client_;
-  Client action_{"/amytiss/synthesize", true};
-};
+using amytiss_test::kActionWaitSeconds;
+using amytiss_test::kSlowConfig;
+using Client = actionlib::SimpleActionClient<amytiss_msgs::SynthesizeAction>;
+using ResynthesisTest = amytiss_test::SynthesizerAndServerTest;
 
 TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
-  const amytiss::PolicyStatus before = status_.latest();
+  const amytiss_msgs::PolicyStatus before = status_.latest();
 
   // Requests keep being answered, successfully, during the whole re-synthesis and swap.
   std::atomic<bool> stop{false};
   std::atomic<int> answered{0}, failed{0};
+  std::string first_failure;  // written by the caller thread only, read after join()
   std::thread caller([&] {
-    ros::ServiceClient client = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input");
+    // One persistent connection for the whole loop (see rostest_fixture.hpp).
+    ros::ServiceClient client = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
     while (!stop) {
-      amytiss::GetInput service;
+      amytiss_msgs::GetInput service;
       service.request.state = {-4.0, -4.0};
       service.request.time_step = 0;
-      if (client.call(service) && service.response.success) ++answered; else ++failed;
+      const bool called = client.call(service);
+      if (called && service.response.success) {
+        ++answered;
+      } else if (++failed == 1) {
+        first_failure = called ? service.response.message : "the service call itself failed";
+      }
     }
   });
 
@@ -78,12 +46,12 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   target_lb[0] = 2.0;
   target_lb[1] = 2.0;
   ros::param::set(kSynthesizer + "/spec/target/lb", target_lb);
-  const amytiss::SynthesizeResult changed = run_goal(amytiss::SynthesizeGoal());
+  const amytiss_msgs::SynthesizeResult changed = run_goal(amytiss_msgs::SynthesizeGoal());
   EXPECT_TRUE(changed.success) << changed.message;
   EXPECT_FALSE(changed.reused);
-  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > before.generation; },
+  ASSERT_TRUE(status_.wait_for([&](const amytiss_msgs::PolicyStatus& s) { return s.generation > before.generation; },
                                amytiss_test::kPolicyWaitSeconds));
-  const amytiss::PolicyStatus after = status_.latest();
+  const amytiss_msgs::PolicyStatus after = status_.latest();
   EXPECT_EQ(after.syntheses_run, before.syntheses_run + 1);
   EXPECT_NE(after.config_hash, before.config_hash);
   EXPECT_EQ(after.horizon, 9u);
@@ -97,42 +65,42 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   double probability = -1;
   const std::vector<double> state = {-3.0, -4.0};
   ASSERT_EQ(fresh.policy.lookup(state.data(), 2, 1, expected.data(), &probability), amytiss::LookupStatus::Ok);
-  const amytiss::GetInput::Response response = call(state, 1);
+  const amytiss_msgs::GetInput::Response response = call(state, 1);
   EXPECT_TRUE(response.success);
   EXPECT_EQ(response.input, expected);
   EXPECT_EQ(response.probability, probability);
 
   stop = true;
   caller.join();
-  EXPECT_EQ(failed.load(), 0);
+  EXPECT_EQ(failed.load(), 0) << "first failure: " << first_failure;
   EXPECT_GT(answered.load(), 0);
 
   // Unchanged parameters: the file is reused, nothing is computed.
-  const amytiss::SynthesizeResult unchanged = run_goal(amytiss::SynthesizeGoal());
+  const amytiss_msgs::SynthesizeResult unchanged = run_goal(amytiss_msgs::SynthesizeGoal());
   EXPECT_TRUE(unchanged.success) << unchanged.message;
   EXPECT_TRUE(unchanged.reused);
   EXPECT_NE(unchanged.message.find("reusing"), std::string::npos) << unchanged.message;
-  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > after.generation; },
+  ASSERT_TRUE(status_.wait_for([&](const amytiss_msgs::PolicyStatus& s) { return s.generation > after.generation; },
                                amytiss_test::kPolicyWaitSeconds));
   EXPECT_EQ(status_.latest().syntheses_run, after.syntheses_run);
   EXPECT_EQ(status_.latest().phase, "reused");
 
   // force: computed again although the file is valid.
-  amytiss::SynthesizeGoal forced;
+  amytiss_msgs::SynthesizeGoal forced;
   forced.force = true;
-  const amytiss::SynthesizeResult recomputed = run_goal(forced);
+  const amytiss_msgs::SynthesizeResult recomputed = run_goal(forced);
   EXPECT_TRUE(recomputed.success);
   EXPECT_FALSE(recomputed.reused);
 }
 
 TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
-  const amytiss::PolicyStatus before = status_.latest();
+  const amytiss_msgs::PolicyStatus before = status_.latest();
   std::atomic<int> feedbacks{0};
-  amytiss::SynthesizeGoal goal;
+  amytiss_msgs::SynthesizeGoal goal;
   goal.config_yaml = kSlowConfig;
   goal.force = true;
   action_.sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                   [&](const amytiss::SynthesizeFeedbackConstPtr& feedback) {
+                   [&](const amytiss_msgs::SynthesizeFeedbackConstPtr& feedback) {
                      if (feedback->phase == "synthesis") ++feedbacks;
                    });
   ASSERT_TRUE(amytiss_test::poll_until([&] { return feedbacks > 0; }, kActionWaitSeconds));
@@ -140,8 +108,8 @@ TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
   ASSERT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
   EXPECT_EQ(action_.getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   EXPECT_FALSE(action_.getResult()->success);
-  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
-  const amytiss::PolicyStatus after = status_.latest();
+  ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
+  const amytiss_msgs::PolicyStatus after = status_.latest();
   EXPECT_TRUE(after.ready);
   EXPECT_EQ(after.generation, before.generation);
   EXPECT_EQ(after.config_hash, before.config_hash);
@@ -149,14 +117,14 @@ TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
 }
 
 TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
-  const amytiss::PolicyStatus before = status_.latest();
-  amytiss::SynthesizeGoal goal;
+  const amytiss_msgs::PolicyStatus before = status_.latest();
+  amytiss_msgs::SynthesizeGoal goal;
   goal.config_yaml = std::string(kSlowConfig) + "\n";
   goal.config_yaml.replace(goal.config_yaml.find("horizon: 40"), 11, "horizon: 0");
-  const amytiss::SynthesizeResult result = run_goal(goal);
+  const amytiss_msgs::SynthesizeResult result = run_goal(goal);
   EXPECT_FALSE(result.success);
   EXPECT_NE(result.message.find("horizon"), std::string::npos) << result.message;
-  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
+  ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
   EXPECT_NE(status_.latest().message.find("horizon"), std::string::npos);
   EXPECT_TRUE(status_.latest().ready);
   EXPECT_EQ(status_.latest().generation, before.generation);
@@ -165,12 +133,4 @@ TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "amytiss_resynthesis_test");
-  ros::AsyncSpinner spinner(3);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  ros::shutdown();
-  return result;
-}
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_resynthesis_test", 3); }

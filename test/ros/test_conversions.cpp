@@ -125,6 +125,8 @@ class LookupConversions : public ::testing::Test {
     const amytiss::Abstraction abstraction =
         amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
     policy_ = new amytiss::Policy(amytiss::synthesize_reference(abstraction, {}));
+    policy_->config_hash = "0123456789abcdef";
+    policy_->run_id = "fedcba9876543210";
   }
   static void TearDownTestSuite() { delete policy_; }
   static amytiss::Policy* policy_;
@@ -132,7 +134,7 @@ class LookupConversions : public ::testing::Test {
 amytiss::Policy* LookupConversions::policy_ = nullptr;
 
 TEST_F(LookupConversions, ResponseEqualsThePolicyForEveryCellAndStep) {
-  amytiss::GetInput::Response response;
+  amytiss_msgs::GetInput::Response response;
   std::vector<double> expected_input(policy_->inputs.dims());
   for (unsigned step = 0; step < policy_->horizon; ++step) {
     for (std::size_t cell = 0; cell < policy_->states.size(); ++cell) {
@@ -160,7 +162,7 @@ TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
                {{0.0, -5.3}, 0, "outside"},    {{0.0, 0.0}, 14, "horizon"},       {{0.0, 0.0}, 1000, "horizon"},
                {{}, 0, "expected 2"}};
   for (const auto& c : cases) {
-    amytiss::GetInput::Response response;
+    amytiss_msgs::GetInput::Response response;
     response.input = {42.0};
     amytiss_ros::fill_get_input_response(policy_, c.state, c.step, "", response);
     EXPECT_FALSE(response.success);
@@ -171,20 +173,45 @@ TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
 }
 
 TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
-  amytiss::GetInput::Response response;
+  amytiss_msgs::GetInput::Response response;
   amytiss_ros::fill_get_input_response(nullptr, {0.0, 0.0}, 0, "synthesis is running (42%)", response);
   EXPECT_FALSE(response.success);
   EXPECT_EQ(response.message, "no policy yet: synthesis is running (42%)");
   EXPECT_TRUE(response.input.empty());
+  EXPECT_EQ(response.config_hash, "");
+  EXPECT_EQ(response.run_id, "");
+}
+
+TEST_F(LookupConversions, AnswersNameThePolicyAndCarryTheServerNotice) {
+  const std::string notice = "synthesizer not running since 2025-11-26 13:05:00 UTC (no status for 15.2 s); "
+                             "serving policy 'tiny'";
+  amytiss_msgs::GetInput::Response response;
+  amytiss_ros::fill_get_input_response(policy_, {0.0, 0.0}, 0, notice, response);
+  EXPECT_TRUE(response.success);
+  EXPECT_EQ(response.message, notice);
+  EXPECT_EQ(response.config_hash, "0123456789abcdef");
+  EXPECT_EQ(response.run_id, "fedcba9876543210");
+
+  amytiss_msgs::StateStamped state;
+  state.state = {0.0, 0.0};
+  amytiss_msgs::InputCommand command;
+  amytiss_ros::fill_input_command(policy_, state, notice, command);
+  EXPECT_TRUE(command.valid);
+  EXPECT_EQ(command.message, notice);
+  EXPECT_EQ(command.config_hash, "0123456789abcdef");
+  EXPECT_EQ(command.run_id, "fedcba9876543210");
+  amytiss_ros::fill_input_command(nullptr, state, "waiting", command);
+  EXPECT_FALSE(command.valid);
+  EXPECT_EQ(command.config_hash, "");
 }
 
 TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerialization) {
-  amytiss::StateStamped state;
+  amytiss_msgs::StateStamped state;
   state.header.stamp = ros::Time(12, 345);
   state.header.frame_id = "map";
   state.state = {-4.0, -4.1};
   state.time_step = 3;
-  amytiss::InputCommand command;
+  amytiss_msgs::InputCommand command;
   amytiss_ros::fill_input_command(policy_, state, "", command);
   ASSERT_TRUE(command.valid) << command.message;
   EXPECT_EQ(command.header.stamp, state.header.stamp);
@@ -201,7 +228,7 @@ TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerializa
   std::vector<uint8_t> buffer(length);
   ros::serialization::OStream out(buffer.data(), length);
   ros::serialization::serialize(out, command);
-  amytiss::InputCommand decoded;
+  amytiss_msgs::InputCommand decoded;
   ros::serialization::IStream in(buffer.data(), length);
   ros::serialization::deserialize(in, decoded);
   EXPECT_EQ(decoded, command);
@@ -221,7 +248,7 @@ TEST(ProgressConversions, FeedbackCarriesEveryField) {
   progress.device = "reference";
   progress.elapsed_s = 1.5;
   progress.remaining_s = 2.0;
-  const amytiss::SynthesizeFeedback feedback = amytiss_ros::feedback_from_progress(progress);
+  const amytiss_msgs::SynthesizeFeedback feedback = amytiss_ros::feedback_from_progress(progress);
   EXPECT_EQ(feedback.phase, "synthesis");
   EXPECT_EQ(feedback.steps_done, 7u);
   EXPECT_EQ(feedback.steps_total, 16u);
@@ -344,15 +371,15 @@ int main(int argc, char** argv) {
 // The engine's phase names are the message constants, in PolicyStatus and in the action feedback.
 TEST(ProgressConversions, PhaseNamesAreTheMessageConstants) {
   const std::pair<amytiss::Phase, std::string> status_phases[] = {
-      {amytiss::Phase::Setup, amytiss::PolicyStatus::PHASE_SETUP},
-      {amytiss::Phase::Construction, amytiss::PolicyStatus::PHASE_CONSTRUCTION},
-      {amytiss::Phase::Synthesis, amytiss::PolicyStatus::PHASE_SYNTHESIS},
-      {amytiss::Phase::Done, amytiss::PolicyStatus::PHASE_DONE}};
+      {amytiss::Phase::Setup, amytiss_msgs::PolicyStatus::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss_msgs::PolicyStatus::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss_msgs::PolicyStatus::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss_msgs::PolicyStatus::PHASE_DONE}};
   for (const auto& [phase, name] : status_phases) EXPECT_EQ(amytiss::to_string(phase), name);
   const std::pair<amytiss::Phase, std::string> feedback_phases[] = {
-      {amytiss::Phase::Setup, amytiss::SynthesizeFeedback::PHASE_SETUP},
-      {amytiss::Phase::Construction, amytiss::SynthesizeFeedback::PHASE_CONSTRUCTION},
-      {amytiss::Phase::Synthesis, amytiss::SynthesizeFeedback::PHASE_SYNTHESIS},
-      {amytiss::Phase::Done, amytiss::SynthesizeFeedback::PHASE_DONE}};
+      {amytiss::Phase::Setup, amytiss_msgs::SynthesizeFeedback::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss_msgs::SynthesizeFeedback::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss_msgs::SynthesizeFeedback::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss_msgs::SynthesizeFeedback::PHASE_DONE}};
   for (const auto& [phase, name] : feedback_phases) EXPECT_EQ(amytiss::to_string(phase), name);
 }

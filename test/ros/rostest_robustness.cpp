@@ -1,0 +1,147 @@
+// rostest: hostile expressions (parameters and goal) are refused on /amytiss/status and the node
+// stays up; a zeroed policy file is refused and computed again; /diagnostics of both nodes.
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <mutex>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+
+#include "amytiss/errors.hpp"
+#include "amytiss/policy_file.hpp"
+#include "rostest_fixture.hpp"
+
+namespace {
+
+constexpr double kNoticeWaitSeconds = 20.0;
+const std::string kSynthesizer = "/amytiss/synthesizer";
+
+std::string repeat(const std::string& piece, std::size_t times) {
+  std::string text;
+  for (std::size_t i = 0; i < times; ++i) text += piece;
+  return text;
+}
+
+class RobustnessTest : public amytiss_test::SynthesizerAndServerTest {
+ protected:
+  // A goal that must be refused with each of `expected` in its result and on /amytiss/status.
+  void expect_refused(const amytiss_msgs::SynthesizeGoal& goal, const std::vector<std::string>& expected) {
+    const amytiss_msgs::SynthesizeResult result = run_goal(goal);
+    EXPECT_FALSE(result.success);
+    ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
+    for (const auto& part : expected) {
+      EXPECT_NE(std::string::npos, result.message.find(part)) << result.message.substr(0, 500);
+      EXPECT_NE(std::string::npos, status_.latest().message.find(part)) << status_.latest().message.substr(0, 500);
+    }
+    EXPECT_LT(status_.latest().message.size(), 1000u) << "the expression is abbreviated";
+    EXPECT_TRUE(call().success) << "the last good policy is still served";
+  }
+};
+
+TEST_F(RobustnessTest, DeepAndLongExpressionsAreRefusedAndTheNodeStaysUp) {
+  XmlRpc::XmlRpcValue good_dynamics;
+  ASSERT_TRUE(ros::param::get(kSynthesizer + "/dynamics", good_dynamics));
+  XmlRpc::XmlRpcValue deep = good_dynamics;
+  deep[0] = repeat("(", 10000) + "x0" + repeat(")", 10000);
+  ros::param::set(kSynthesizer + "/dynamics", deep);
+  expect_refused(amytiss_msgs::SynthesizeGoal(), {"dynamics[0]: column ", "nested deeper than the limit of 256"});
+  deep[0] = repeat("-", 60000) + "x0";
+  ros::param::set(kSynthesizer + "/dynamics", deep);
+  expect_refused(amytiss_msgs::SynthesizeGoal(), {"nested deeper than the limit of 256"});
+  ros::param::set(kSynthesizer + "/dynamics", good_dynamics);
+
+  // Through a goal: abs( nested 100,000 deep, ^1 repeated, a 10 MB flat sum.
+  const std::string head = "name: hostile\nstates: {lb: [-1], ub: [1], eta: [0.5]}\ndynamics: [\"";
+  const std::string tail = "\"]\nnoise: {covariance: [0.1]}\nspec: {type: safety, horizon: 2}\n";
+  amytiss_msgs::SynthesizeGoal goal;
+  goal.config_yaml = head + repeat("abs(", 100000) + "x0" + repeat(")", 100000) + tail;
+  expect_refused(goal, {"characters long, more than the limit of 65536"});
+  goal.config_yaml = head + "x0" + repeat("^1", 30000) + tail;
+  expect_refused(goal, {"nested deeper than the limit of 256"});
+  goal.config_yaml = head + "x0" + repeat(" + x0", 2 * 1024 * 1024) + tail;
+  expect_refused(goal, {"10485762 characters long"});
+
+  // Alive: the unchanged configuration is reused.
+  const amytiss_msgs::SynthesizeResult result = run_goal(amytiss_msgs::SynthesizeGoal());
+  EXPECT_TRUE(result.success) << result.message;
+  EXPECT_TRUE(result.reused);
+}
+
+TEST_F(RobustnessTest, AZeroedPolicyFileIsRefusedAndComputedAgain) {
+  const amytiss_msgs::PolicyStatus before = status_.latest();
+  const std::string file = before.policy_file;
+  const amytiss::LoadedPolicy loaded = amytiss::read_policy_file(file);
+  std::string bytes;
+  {
+    std::ifstream input(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(input), std::istreambuf_iterator<char>());
+  }
+  // 4096 zero bytes inside /values (zeros are valid probabilities: only a checksum tells), from
+  // the first 8 values that are not all equal, so the pattern is found only there.
+  const auto& values = loaded.policy.values;
+  std::size_t first = 0;
+  while (first + 8 < values.size() && std::equal(values.begin() + first + 1, values.begin() + first + 8,
+                                                  values.begin() + first))
+    ++first;
+  const std::string pattern(reinterpret_cast<const char*>(values.data() + first), 8 * sizeof(double));
+  const std::size_t at = bytes.find(pattern);
+  ASSERT_NE(std::string::npos, at);
+  {
+    std::fstream output(file, std::ios::in | std::ios::out | std::ios::binary);
+    output.seekp(std::streamoff(at));
+    const std::string zeros(4096, '\0');
+    output.write(zeros.data(), std::streamsize(zeros.size()));
+  }
+  EXPECT_THROW(amytiss::read_policy_file(file), amytiss::PolicyFileError);
+
+  const amytiss_msgs::SynthesizeResult result = run_goal(amytiss_msgs::SynthesizeGoal());
+  EXPECT_TRUE(result.success) << result.message;
+  EXPECT_FALSE(result.reused) << "a corrupt file must not be reused";
+  EXPECT_EQ(before.syntheses_run + 1, status_.latest().syntheses_run);
+  EXPECT_NE(before.run_id, status_.latest().run_id);
+  EXPECT_NO_THROW(amytiss::read_policy_file(file));
+  const std::string new_run = status_.latest().run_id;
+  ASSERT_TRUE(amytiss_test::poll_until([&] { return call().run_id == new_run; }, kNoticeWaitSeconds));
+}
+
+TEST_F(RobustnessTest, BothNodesPublishDiagnostics) {
+  std::mutex mutex;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> latest;  // by status name
+  const ros::Subscriber subscriber = handle_.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const auto& status : array->status) latest[status.name] = status;
+      });
+  const auto find = [&](const std::string& part, diagnostic_msgs::DiagnosticStatus& out) {
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [name, status] : latest)
+      if (name.find(part) != std::string::npos) {
+        out = status;
+        return true;
+      }
+    return false;
+  };
+  diagnostic_msgs::DiagnosticStatus server, synthesizer;
+  ASSERT_TRUE(amytiss_test::poll_until([&] { return find("policy server", server) && find(": synthesizer", synthesizer); },
+                                       kNoticeWaitSeconds));
+  const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
+    for (const auto& pair : status.values)
+      if (pair.key == key) return pair.value;
+    return std::string("<missing>");
+  };
+  const amytiss_msgs::PolicyStatus current = status_.latest();
+  EXPECT_EQ(diagnostic_msgs::DiagnosticStatus::OK, server.level) << server.message;
+  EXPECT_EQ("True", value(server, "policy loaded"));
+  EXPECT_EQ(current.config_name, value(server, "policy name"));
+  EXPECT_EQ(current.config_hash, value(server, "policy config_hash"));
+  EXPECT_EQ(current.run_id, value(server, "policy run_id"));
+  EXPECT_EQ("running", value(server, "synthesizer"));
+  EXPECT_NE("<missing>", value(server, "policy age (s)"));
+  EXPECT_EQ(current.run_id, value(synthesizer, "run_id"));
+  EXPECT_EQ(current.device, value(synthesizer, "device"));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return amytiss_test::run_rostests(argc, argv, "amytiss_rostest_robustness", 2); }
