@@ -70,6 +70,7 @@ struct FileAttributes {
   std::string config_hash, computed_by, run_id;
   std::uint64_t engine_version = 0, horizon = 0;
   std::string spec;
+  std::uint64_t stationary = 0, iterations = 0;  // unbounded specifications only
 };
 
 void add_attributes(ContentDigest& digest, const FileAttributes& attributes) {
@@ -81,6 +82,11 @@ void add_attributes(ContentDigest& digest, const FileAttributes& attributes) {
   digest.add(attributes.engine_version);
   digest.add(attributes.horizon);
   digest.add(attributes.spec);
+  // Present only in files of unbounded specifications: other files keep their digest.
+  if (attributes.stationary) {
+    digest.add(attributes.stationary);
+    digest.add(attributes.iterations);
+  }
 }
 
 void add_grid(ContentDigest& digest, const Grid& grid) {
@@ -107,6 +113,7 @@ std::string digest_of(const FileAttributes& attributes, const std::string& confi
   std::vector<std::uint8_t> roles(policy.roles.size());
   for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = std::uint8_t(policy.roles[i]);
   digest.add(roles);
+  if (policy.stationary) digest.add(policy.upper_values);
   return digest.hex();
 }
 
@@ -269,6 +276,8 @@ void write_contents(hid_t file, const Policy& policy, const Config& config, cons
   attributes.engine_version = engine_version;
   attributes.horizon = policy.horizon;
   attributes.spec = to_string(config.spec.type);
+  attributes.stationary = policy.stationary ? 1 : 0;
+  attributes.iterations = policy.stationary ? policy.iterations : 0;
   const std::string config_yaml = to_yaml(config);
 
   Writer writer(file);
@@ -280,6 +289,10 @@ void write_contents(hid_t file, const Policy& policy, const Config& config, cons
   writer.unsigned_attribute("engine_version", attributes.engine_version);
   writer.unsigned_attribute("horizon", attributes.horizon);
   writer.string_attribute("spec", attributes.spec);
+  if (attributes.stationary) {
+    writer.unsigned_attribute("stationary", attributes.stationary);
+    writer.unsigned_attribute("iterations", attributes.iterations);
+  }
   writer.string_attribute("content_digest", digest_of(attributes, config_yaml, policy));
   writer.string_dataset("/config", config_yaml);
   writer.grid("/states", policy.states);
@@ -298,6 +311,8 @@ void write_contents(hid_t file, const Policy& policy, const Config& config, cons
   role_shape.erase(role_shape.begin());
   static_assert(sizeof(CellRole) == sizeof(std::uint8_t), "roles are stored as uint8");
   writer.dataset("/roles", role_shape, H5T_STD_U8LE, H5T_NATIVE_UINT8, policy.roles.data());
+  if (policy.stationary)
+    writer.dataset("/upper_values", role_shape, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, policy.upper_values.data());
 }
 
 void check_policy_consistent(const Policy& policy) {
@@ -314,6 +329,10 @@ void check_policy_consistent(const Policy& policy) {
   if (policy.roles.size() != cells)
     throw PolicyFileError("cannot write a policy with " + std::to_string(policy.roles.size()) +
                           " cell roles: expected " + std::to_string(cells));
+  if (policy.stationary && (policy.horizon != 1 || policy.upper_values.size() != cells))
+    throw PolicyFileError("cannot write a stationary policy with horizon " + std::to_string(policy.horizon) + " and " +
+                          std::to_string(policy.upper_values.size()) + " upper bounds: expected horizon 1 and " +
+                          std::to_string(cells));
 }
 
 // The reader refuses such files, so the writer refuses to produce them.
@@ -322,6 +341,10 @@ void check_policy_values(const Policy& policy) {
     if (!(policy.values[i] >= 0.0 && policy.values[i] <= 1.0))
       throw PolicyFileError("cannot write a policy whose value " + std::to_string(i) + " is " +
                             std::to_string(policy.values[i]) + " (expected a probability)");
+  for (std::size_t i = 0; i < policy.upper_values.size(); ++i)
+    if (!(policy.upper_values[i] >= 0.0 && policy.upper_values[i] <= 1.0))
+      throw PolicyFileError("cannot write a policy whose upper bound " + std::to_string(i) + " is " +
+                            std::to_string(policy.upper_values[i]) + " (expected a probability)");
   for (std::size_t i = 0; i < policy.input_index.size(); ++i)
     if (policy.input_index[i] >= policy.inputs.size())
       throw PolicyFileError("cannot write a policy whose input index " + std::to_string(i) +
@@ -544,6 +567,15 @@ Policy read_contents(hid_t file, const std::string& path, LoadedPolicy& loaded) 
     reader.fail("horizon " + std::to_string(attributes.horizon) + " is out of range (expected >= 1)");
   policy.horizon = unsigned(attributes.horizon);
   attributes.spec = reader.string_attribute("spec");
+  if (reader.has_attribute("stationary")) {
+    attributes.stationary = reader.unsigned_attribute("stationary");
+    if (attributes.stationary != 1 || attributes.horizon != 1)
+      reader.fail("stationary is " + std::to_string(attributes.stationary) + " with horizon " +
+                  std::to_string(attributes.horizon) + ", expected stationary 1 with horizon 1");
+    attributes.iterations = reader.unsigned_attribute("iterations");
+    policy.stationary = true;
+    policy.iterations = unsigned(std::min<std::uint64_t>(attributes.iterations, std::numeric_limits<unsigned>::max()));
+  }
   const std::string stored_digest = reader.string_attribute("content_digest");
   loaded.config_yaml = reader.string_dataset("/config");
 
@@ -590,6 +622,16 @@ Policy read_contents(hid_t file, const std::string& path, LoadedPolicy& loaded) 
       reader.fail("'/roles' element " + std::to_string(i) + " is " + std::to_string(roles[i]) +
                   ", expected 0 (free), 1 (fixed zero) or 2 (fixed one)");
     policy.roles.push_back(CellRole(roles[i]));
+  }
+  if (policy.stationary) {
+    policy.upper_values =
+        reader.numeric_dataset<double>("/upper_values", H5T_FLOAT, H5T_NATIVE_DOUBLE, role_shape);
+    for (std::size_t i = 0; i < policy.upper_values.size(); ++i) {
+      if (!(policy.upper_values[i] >= 0.0 && policy.upper_values[i] <= 1.0))
+        reader.fail("'/upper_values' element " + std::to_string(i) + " is " + std::to_string(policy.upper_values[i]) +
+                    ", expected a probability in [0, 1]");
+      policy.gap = std::max(policy.gap, policy.upper_values[i] - policy.values[i]);
+    }
   }
   const std::string digest = digest_of(attributes, loaded.config_yaml, policy);
   if (digest != stored_digest)

@@ -125,6 +125,46 @@ TEST_F(PolicyFileTest, RoundTripOfAnAutonomousSystem) {
   expect_same_policy(policy, loaded.policy);
 }
 
+// An unbounded specification's stationary policy: the flag, the iterations and the upper bound
+// come back, the step is ignored by lookup, and a changed upper bound is refused by the digest.
+TEST_F(PolicyFileTest, RoundTripOfAStationaryPolicy) {
+  Config config = tiny_config();
+  config.spec.unbounded = true;
+  config.spec.horizon = 0;
+  Policy policy = tiny_policy(config);
+  policy.horizon = 1;
+  policy.values.clear();
+  policy.input_index.clear();
+  Policy shape = tiny_policy(tiny_config());
+  const std::size_t cells = policy.states.size();
+  policy.values.assign(shape.values.begin(), shape.values.begin() + std::ptrdiff_t(cells));
+  policy.values.insert(policy.values.end(), policy.values.begin(), policy.values.end());
+  policy.input_index.assign(shape.input_index.begin(), shape.input_index.begin() + std::ptrdiff_t(cells));
+  policy.stationary = true;
+  policy.iterations = 321;
+  for (std::size_t cell = 0; cell < cells; ++cell) policy.upper_values.push_back(std::min(1.0, policy.values[cell] + 1e-7));
+  write_policy_file(path("stationary.h5"), policy, config);
+  const LoadedPolicy loaded = read_policy_file_for(path("stationary.h5"), config);
+  expect_same_policy(policy, loaded.policy);
+  EXPECT_TRUE(loaded.policy.stationary);
+  EXPECT_EQ(321u, loaded.policy.iterations);
+  EXPECT_EQ(policy.upper_values, loaded.policy.upper_values);
+  EXPECT_NEAR(loaded.policy.gap, 1e-7, 1e-12);
+  const double state[] = {0.5, 1.0};
+  double input[1], probability = -1;
+  EXPECT_EQ(loaded.policy.lookup(state, 2, 7, input, &probability), LookupStatus::Ok);
+  EXPECT_EQ(probability, loaded.policy.value(0, *loaded.policy.states.cell_of(state)));
+
+  // A finite policy's file has no stationary attribute, and its reader stays non-stationary.
+  write_policy_file(path("finite.h5"), tiny_policy(tiny_config()), tiny_config());
+  EXPECT_FALSE(read_policy_file(path("finite.h5")).policy.stationary);
+
+  Policy wrong = policy;
+  wrong.upper_values.pop_back();
+  EXPECT_NE(refusal([&] { write_policy_file(path("wrong.h5"), wrong, config); }).find("upper bounds"),
+            std::string::npos);
+}
+
 TEST_F(PolicyFileTest, OverwritesAnExistingFile) {
   const Config config = tiny_config();
   Policy policy = tiny_policy(config);
