@@ -172,6 +172,24 @@ TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
   }
 }
 
+// An unbounded specification's stationary policy answers any time_step with its lower bound.
+TEST_F(LookupConversions, StationaryPolicyIgnoresTheStep) {
+  amytiss::Config config = amytiss::load_config_file(kTinyConfig);
+  config.spec.unbounded = true;
+  config.spec.horizon = 0;
+  const amytiss::Policy stationary =
+      amytiss::synthesize_reference(amytiss::Abstraction::from_config(config), {});
+  ASSERT_TRUE(stationary.stationary);
+  for (unsigned step : {0u, 1u, 57u, 4000000000u}) {
+    for (std::size_t cell = 0; cell < stationary.states.size(); ++cell) {
+      amytiss_msgs::GetInput::Response response;
+      amytiss_ros::fill_get_input_response(&stationary, stationary.states.point(cell), step, "", response);
+      ASSERT_TRUE(response.success) << response.message;
+      ASSERT_EQ(response.probability, stationary.value(0, cell));
+    }
+  }
+}
+
 TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
   amytiss_msgs::GetInput::Response response;
   amytiss_ros::fill_get_input_response(nullptr, {0.0, 0.0}, 0, "synthesis is running (42%)", response);
