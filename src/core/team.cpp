@@ -177,4 +177,19 @@ std::vector<std::string> Team::describe(const Split& split, const std::string& w
   return lines;
 }
 
+void report_team_step(const Abstraction& a, unsigned step, double step_seconds, double multiply_adds,
+                      double synthesis_seconds, SynthesisReport& rep, const TeamProgress& progress) {
+  rep.phases.push_back({"step " + std::to_string(step), step_seconds, double(a.pairs()) / std::max(step_seconds, 1e-9),
+                        multiply_adds, 0});
+  const unsigned done = a.horizon - step;
+  if (progress)
+    progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done, synthesis_seconds / done * (a.horizon - done));
+}
+
+void report_team_exchange(const Abstraction& a, const Team& team, SynthesisReport& rep) {
+  rep.exchange_seconds = team.exchange_seconds();
+  rep.phases.push_back(
+      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+}
+
 }  // namespace amytiss::detail

@@ -69,6 +69,13 @@ struct Layout;
 /// Called after construction and after each time step (phase, steps done, seconds left or -1).
 using TeamProgress = std::function<void(Phase, unsigned, double)>;
 
+/// The end of a team run's time step `step`: its phase in the report (seconds, pairs per second,
+/// multiply-adds) and the progress (steps done, seconds left from the synthesis so far).
+void report_team_step(const Abstraction& abstraction, unsigned step, double step_seconds, double multiply_adds,
+                      double synthesis_seconds, SynthesisReport& report, const TeamProgress& progress);
+/// After the last step: the exchanges' time and bytes as a breakdown phase.
+void report_team_exchange(const Abstraction& abstraction, const Team& team, SynthesisReport& report);
+
 /// The dense sweep over the team: device i of rank r constructs and sweeps its contiguous slice
 /// of the states; after every step the new values (and inputs) of every slice go to every device.
 Policy run_dense_team(const Abstraction& abstraction, Team& team, const SynthesisOptions& options,

@@ -111,16 +111,9 @@ Policy run_dense_team(const Abstraction& a, Team& team, const SynthesisOptions& 
                   policy.input_index.data() + std::size_t(step) * n_states, false);
     current = 1 - current;
     unpad(policy, step, padded_index, host_values.data());
-    const double seconds = seconds_since(phase_start);
-    rep.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9), 0, 0});
-    const unsigned done = a.horizon - step;
-    if (progress)
-      progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done,
-               seconds_since(synthesis_start) / done * (a.horizon - done));
+    report_team_step(a, step, seconds_since(phase_start), 0, seconds_since(synthesis_start), rep, progress);
   }
-  rep.exchange_seconds = team.exchange_seconds();
-  rep.phases.push_back(
-      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+  report_team_exchange(a, team, rep);
   return policy;
 }
 

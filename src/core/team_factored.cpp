@@ -193,17 +193,10 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
     std::copy(host_values.begin(), host_values.begin() + std::ptrdiff_t(n_states),
               policy.values.begin() + std::ptrdiff_t(std::size_t(step) * n_states));
     current = 1 - current;
-    const double seconds = seconds_since(phase_start);
-    rep.phases.push_back({"step " + std::to_string(step), seconds, double(a.pairs()) / std::max(seconds, 1e-9),
-                          multiply_adds_per_step, 0});
-    const unsigned done = a.horizon - step;
-    if (progress)
-      progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done,
-               seconds_since(synthesis_start) / done * (a.horizon - done));
+    report_team_step(a, step, seconds_since(phase_start), multiply_adds_per_step, seconds_since(synthesis_start), rep,
+                     progress);
   }
-  rep.exchange_seconds = team.exchange_seconds();
-  rep.phases.push_back(
-      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+  report_team_exchange(a, team, rep);
   return policy;
 }
 
