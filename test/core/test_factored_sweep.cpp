@@ -31,7 +31,7 @@ constexpr double kMassTolerance = 1e-15;
 constexpr double kInputMarginTolerance = 1e-12;
 constexpr double kUnlimitedBudget = 1e12;
 
-Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+using test_support::from_yaml;
 
 // The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
 std::string traffic_yaml(double eta, unsigned horizon) {

@@ -28,7 +28,7 @@ constexpr double kQuadratureTolerance = 5e-12;
 constexpr double kEngineTolerance = 1e-5;
 constexpr double kMonteCarloStandardErrors = 4.0;
 
-Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+using test_support::from_yaml;
 
 std::string expect_config_error(const std::string& text, const std::string& key) {
   try {

@@ -35,9 +35,6 @@ constexpr double kValueTolerance = 1e-5;
 // Inputs must agree wherever the best input beats the chosen one by more than this.
 constexpr double kInputMarginTolerance = 1e-5;
 
-Abstraction from_yaml(const std::string& text) {
-  return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
-}
 
 SynthesisOptions cpu_options(TransitionStorage transitions = TransitionStorage::Auto) {
   SynthesisOptions options;

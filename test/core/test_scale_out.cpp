@@ -17,6 +17,7 @@
 #include "opencl_engine.hpp"
 #include "partition.hpp"
 #include "team.hpp"
+#include "test_support.hpp"
 
 namespace amytiss {
 namespace {
@@ -26,7 +27,7 @@ namespace {
 const std::vector<std::string> kParts = {"cpu:0/1"};
 const std::vector<std::string> kUnequal = {"cpu:0", "cpu:0/1"};
 
-Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+using test_support::from_yaml;
 
 // Traffic-like 3-d chain (each coordinate reads two states and at most one input): factored.
 std::string chain_yaml() {

@@ -130,6 +130,11 @@ inline Config make_config(GridSpec states, std::optional<GridSpec> inputs, std::
   return config;
 }
 
+/// The abstraction of a configuration given as YAML text (validated, like a configuration file).
+inline Abstraction from_yaml(const std::string& text) {
+  return Abstraction::from_config(config_from_yaml(YAML::Load(text)));
+}
+
 inline Abstraction make_abstraction(const Config& config, std::shared_ptr<const Dynamics> dynamics) {
   return Abstraction::from_parts(config, std::move(dynamics));
 }

@@ -10,6 +10,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
+#include "test_support.hpp"
 
 namespace amytiss {
 namespace {
@@ -19,7 +20,7 @@ constexpr double kTolerance = 1e-6;
 constexpr double kOpenClTolerance = 1e-5;
 constexpr double kRounding = 1e-12;
 
-Abstraction from_yaml(const std::string& text) { return Abstraction::from_config(config_from_yaml(YAML::Load(text))); }
+using test_support::from_yaml;
 
 Policy run(const Abstraction& a, DeviceKind device, SweepChoice sweep, SynthesisReport* report) {
   SynthesisOptions options;
