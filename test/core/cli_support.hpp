@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "test_support.hpp"
+
 namespace amytiss {
 namespace test_support {
 
@@ -35,11 +37,7 @@ inline std::string quote(const std::string& text) { return "'" + text + "'"; }
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = fs::temp_directory_path() /
-                 ("amytiss_cli_test_" + std::to_string(::getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(directory_);
-    fs::create_directories(directory_);
+    directory_ = fresh_test_directory("amytiss_cli_test_");
   }
   void TearDown() override { fs::remove_all(directory_); }
 

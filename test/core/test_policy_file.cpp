@@ -14,6 +14,8 @@
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
 
+#include "test_support.hpp"
+
 namespace amytiss {
 namespace {
 
@@ -57,11 +59,7 @@ Policy tiny_policy(const Config& config) {
 class PolicyFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = fs::temp_directory_path() /
-                 ("amytiss_policy_file_test_" + std::to_string(::getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(directory_);
-    fs::create_directories(directory_);
+    directory_ = test_support::fresh_test_directory("amytiss_policy_file_test_");
   }
   void TearDown() override { fs::remove_all(directory_); }
   std::string path(const std::string& name) const { return (directory_ / name).string(); }
@@ -390,7 +388,7 @@ TEST_F(PolicyFileTest, OneFlippedBitInAnyArrayIsRefused) {
 TEST_F(PolicyFileTest, AChangedConfigurationTextOrAttributeIsRefusedByTheDigest) {
   const Config config = tiny_config();
   const Policy policy = tiny_policy(config);
-  for (const std::string text : {std::string("name: \"policy_file_test\""), std::string("hand-made (test)"),
+  for (const std::string& text : {std::string("name: \"policy_file_test\""), std::string("hand-made (test)"),
                                  std::string("0123456789abcdef")}) {
     write_policy_file(path("p.h5"), policy, config);
     flip_bit(path("p.h5"), offset_of(path("p.h5"), text) + text.size() - 2);

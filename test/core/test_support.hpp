@@ -9,8 +9,12 @@
 //   Config config = make_config(grid_spec({-1}, {1}, {0.5}), grid_spec({-0.5}, {0.5}, {0.5}),
 //                               std::nullopt, normal_noise({0.09}), safety_spec(2));
 //   Abstraction abstraction = Abstraction::from_parts(config, dynamics);
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -128,6 +132,17 @@ inline Config make_config(GridSpec states, std::optional<GridSpec> inputs, std::
   for (std::size_t i = 0; i < config.states.lb.size(); ++i) config.dynamics.push_back("x" + std::to_string(i));
   config.compute.device = DeviceKind::Reference;
   return config;
+}
+
+/// An empty directory for the running test, "<temp>/<prefix><pid>_<test name>" (any earlier one of
+/// that name removed first); the caller removes it when done.
+inline std::filesystem::path fresh_test_directory(const std::string& prefix) {
+  const std::filesystem::path directory =
+      std::filesystem::temp_directory_path() /
+      (prefix + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::remove_all(directory);
+  std::filesystem::create_directories(directory);
+  return directory;
 }
 
 /// The abstraction of a configuration given as YAML text (validated, like a configuration file).
