@@ -8,8 +8,8 @@ find_package(Threads REQUIRED)
 # OpenCL C sources (kernels, and model sources valid both in C++ and OpenCL C) are embedded in the
 # library so the binary runs from any directory.
 file(GLOB AMYTISS_EMBEDDED_INPUTS CONFIGURE_DEPENDS
-  ${CMAKE_CURRENT_SOURCE_DIR}/src/core/kernels/*.cl
-  ${CMAKE_CURRENT_SOURCE_DIR}/src/core/models/*.h)
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/core/opencl/kernels/*.cl
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/core/model/models/*.h)
 set(AMYTISS_EMBEDDED_CPP ${CMAKE_CURRENT_BINARY_DIR}/generated/embedded_sources.cpp)
 string(REPLACE ";" "|" AMYTISS_EMBEDDED_ARG "${AMYTISS_EMBEDDED_INPUTS}")
 add_custom_command(OUTPUT ${AMYTISS_EMBEDDED_CPP}
@@ -19,7 +19,7 @@ add_custom_command(OUTPUT ${AMYTISS_EMBEDDED_CPP}
   COMMENT "Embedding OpenCL and model sources"
   VERBATIM)
 
-file(GLOB AMYTISS_CORE_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/core/*.cpp)
+file(GLOB_RECURSE AMYTISS_CORE_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/core/*.cpp)
 add_library(amytiss_core ${AMYTISS_CORE_SOURCES} ${AMYTISS_EMBEDDED_CPP})
 target_include_directories(amytiss_core PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>

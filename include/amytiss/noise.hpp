@@ -100,7 +100,7 @@ class NoiseModel {
                    double* out) const;
 
   /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
-  /// bound in noise.cpp and docs/semantics.md ("Transition probabilities"); |error| <= box_mass_tolerance().
+  /// bound in model/noise.cpp and docs/semantics.md ("Transition probabilities"); |error| <= box_mass_tolerance().
   /// Method: sequential conditioning x = mean + L z (L Cholesky, z standard normal), nested
   /// composite Gauss-Legendre over z_0..z_{n-2} (panel width <= 1 standard deviation, narrowed
   /// where later bounds depend steeply on z_i), exact erfc for z_{n-1}, z clipped to |z| <= 9.
@@ -136,7 +136,7 @@ class NoiseModel {
   std::vector<std::size_t> counts_;     // the state grid's points per dimension
   std::vector<std::int64_t> window_half_cells_;
   std::vector<char> whole_grid_dims_;  // truncation none (and some noise): the whole dimension
-  // Full covariance quadrature (see noise.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
+  // Full covariance quadrature (see model/noise.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
   // panel width per conditioning level in standard-normal units.
   std::vector<double> legendre_nodes_, legendre_weights_;
   std::vector<double> panel_width_;

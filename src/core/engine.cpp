@@ -3,7 +3,7 @@
 #include "amytiss/engine.hpp"
 
 #include "amytiss/errors.hpp"
-#include "opencl_engine.hpp"
+#include "opencl/engine.hpp"
 
 namespace amytiss {
 

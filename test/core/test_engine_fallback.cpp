@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "amytiss/errors.hpp"
-#include "opencl_engine.hpp"
+#include "opencl/engine.hpp"
 
 namespace amytiss {
 namespace {

@@ -15,7 +15,7 @@
 #include "amytiss/errors.hpp"
 #include "agreement.hpp"
 #include "monte_carlo.hpp"
-#include "noise_laws.hpp"
+#include "model/noise_laws.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {

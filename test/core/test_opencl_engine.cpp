@@ -17,8 +17,8 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
-#include "opencl_engine.hpp"
-#include "opencl_source.hpp"
+#include "opencl/engine.hpp"
+#include "opencl/source.hpp"
 #include "agreement.hpp"
 #include "test_support.hpp"
 

@@ -12,11 +12,11 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
-#include "factored_plan.hpp"
-#include "opencl_device.hpp"
-#include "opencl_engine.hpp"
-#include "partition.hpp"
-#include "team.hpp"
+#include "opencl/factored/plan.hpp"
+#include "opencl/device.hpp"
+#include "opencl/engine.hpp"
+#include "scale_out/partition.hpp"
+#include "scale_out/team.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {

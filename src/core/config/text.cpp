@@ -1,0 +1,105 @@
+// Canonical text of a configuration (all keys, fixed order, full precision) and its hash.
+#include "amytiss/config.hpp"
+#include "amytiss/format.hpp"
+#include "config/messages.hpp"
+
+namespace amytiss {
+namespace {
+
+using detail::format_list;
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string grid_yaml(const GridSpec& grid) {
+  return "{lb: " + format_list(grid.lb) + ", ub: " + format_list(grid.ub) + ", eta: " + format_list(grid.eta) + "}";
+}
+
+std::string box_yaml(const Box& box) { return "{lb: " + format_list(box.lb) + ", ub: " + format_list(box.ub) + "}"; }
+
+std::string canonical_yaml(const Config& config, bool with_compute) {
+  std::string text;
+  text += "name: " + quoted(config.name) + "\n";
+  text += "states: " + grid_yaml(config.states) + "\n";
+  if (config.inputs) text += "inputs: " + grid_yaml(*config.inputs) + "\n";
+  if (config.disturbances) text += "disturbances: " + grid_yaml(*config.disturbances) + "\n";
+  if (!config.constants.empty()) {
+    text += "constants:\n";
+    for (const auto& constant : config.constants) text += "  " + constant.first + ": " + format_number(constant.second) + "\n";
+  }
+  if (!config.model.empty()) text += "model: " + quoted(config.model) + "\n";
+  if (!config.dynamics.empty()) {
+    text += "dynamics:\n";
+    for (const auto& expression : config.dynamics) text += "  - " + quoted(expression) + "\n";
+  }
+  // The default integrator is left out, so configurations without the key keep their text and hash.
+  if (!config.integrator.is_default()) {
+    text += "integrator: {method: " + to_string(config.integrator.method) +
+            ", substeps: " + std::to_string(config.integrator.substeps);
+    if (config.integrator.tau) text += ", tau: " + format_number(*config.integrator.tau);
+    text += "}\n";
+  }
+  const NoiseConfig& noise = config.noise;
+  text += "noise:\n";
+  text += "  type: " + to_string(noise.type) + "\n";
+  text += "  distribution: " + to_string(noise.distribution) + "\n";
+  if (!noise.covariance.empty()) text += "  covariance: " + format_list(noise.covariance) + "\n";
+  if (!noise.half_width.empty()) text += "  half_width: " + format_list(noise.half_width) + "\n";
+  if (!noise.rate.empty()) text += "  rate: " + format_list(noise.rate) + "\n";
+  if (!noise.shift.empty()) text += "  shift: " + format_list(noise.shift) + "\n";
+  if (!noise.alpha.empty()) text += "  alpha: " + format_list(noise.alpha) + "\n";
+  if (!noise.beta.empty()) text += "  beta: " + format_list(noise.beta) + "\n";
+  if (!noise.density.empty()) {
+    text += "  density:\n";
+    for (const auto& expression : noise.density) text += "    - " + quoted(expression) + "\n";
+  }
+  if (noise.support) text += "  support: " + box_yaml(*noise.support) + "\n";
+  text += "  truncation: " + to_string(noise.truncation) + "\n";
+  if (noise.truncation == Truncation::CuttingProbability)
+    text += "  cutting_probability: " + format_number(noise.cutting_probability) + "\n";
+  if (!noise.fixed_region.empty()) text += "  fixed_region: " + format_list(noise.fixed_region) + "\n";
+  text += "spec:\n";
+  text += "  type: " + to_string(config.spec.type) + "\n";
+  if (config.spec.unbounded) {
+    text += "  horizon: infinite\n";
+    text += "  tolerance: " + format_number(config.spec.tolerance) + "\n";
+  } else {
+    text += "  horizon: " + std::to_string(config.spec.horizon) + "\n";
+  }
+  if (config.spec.safe) text += "  safe: " + box_yaml(*config.spec.safe) + "\n";
+  if (config.spec.target) text += "  target: " + box_yaml(*config.spec.target) + "\n";
+  if (config.spec.avoid) text += "  avoid: " + box_yaml(*config.spec.avoid) + "\n";
+  if (with_compute) {
+    const ComputeConfig& compute = config.compute;
+    text += "compute:\n";
+    text += "  device: " + to_string(compute.device) + "\n";
+    text += "  transitions: " + to_string(compute.transitions) + "\n";
+    text += "  sweep: " + to_string(compute.sweep) + "\n";
+    text += "  platform: " + quoted(compute.platform) + "\n";
+    text += "  device_name: " + quoted(compute.device_name) + "\n";
+    text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";
+    if (!compute.devices.empty()) {
+      text += "  devices: [";
+      for (std::size_t i = 0; i < compute.devices.size(); ++i) text += (i ? ", " : "") + quoted(compute.devices[i]);
+      text += "]\n";
+    }
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string to_yaml(const Config& config) { return canonical_yaml(config, true); }
+std::string config_hash(const Config& config) { return hex16(fnv1a64(canonical_yaml(config, false))); }
+
+}  // namespace amytiss

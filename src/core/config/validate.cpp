@@ -1,0 +1,270 @@
+// Config::validate(): the one place that judges a configuration (docs/configuration.md). Errors
+// name the key, the value received and an example of a valid value.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+#include "amytiss/config.hpp"
+#include "amytiss/expression.hpp"
+#include "amytiss/model.hpp"
+#include "config/messages.hpp"
+
+namespace amytiss {
+namespace {
+
+using detail::check_finite_list;
+using detail::check_noise;
+using detail::fail;
+using detail::format_list;
+using detail::indexed;
+using detail::join;
+
+constexpr std::uint64_t kMaxGridPoints = 4294967295ull;          // 2^32 - 1: indices are uint32
+constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
+
+const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
+
+std::uint64_t points_of_dimension(double lb, double ub, double eta) {
+  return static_cast<std::uint64_t>(std::floor((ub - lb) / eta + 0.5)) + 1;
+}
+
+/// Checks a grid and returns its number of points (saturated at UINT64_MAX).
+double check_grid(const GridSpec& grid, const std::string& key, const std::string& omit_hint) {
+  const std::string example = key.substr(key.rfind('.') + 1) + ": " + kGridExample;
+  if (grid.lb.empty())
+    throw ConfigError(key + ".lb", "got [], expected at least one value" + omit_hint + " (example: " + example + ")");
+  check_finite_list(grid.lb, key + ".lb", example);
+  check_finite_list(grid.ub, key + ".ub", example);
+  check_finite_list(grid.eta, key + ".eta", example);
+  if (grid.ub.size() != grid.lb.size())
+    fail(key + ".ub", std::to_string(grid.ub.size()) + " values", std::to_string(grid.lb.size()) +
+         " values, as many as " + key + ".lb", example);
+  if (grid.eta.size() != grid.lb.size())
+    fail(key + ".eta", std::to_string(grid.eta.size()) + " values", std::to_string(grid.lb.size()) +
+         " values, as many as " + key + ".lb", example);
+  double points = 1;
+  for (std::size_t i = 0; i < grid.lb.size(); ++i) {
+    if (grid.eta[i] <= 0)
+      fail(indexed(key + ".eta", i), format_number(grid.eta[i]), "a number > 0", "eta: [0.5, 0.5]");
+    if (grid.lb[i] > grid.ub[i])
+      fail(indexed(key + ".ub", i), format_number(grid.ub[i]),
+           "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(grid.lb[i]), example);
+    points *= std::floor((grid.ub[i] - grid.lb[i]) / grid.eta[i] + 0.5) + 1;
+  }
+  if (points > double(kMaxGridPoints))
+    throw ConfigError(key, "grid too large: " + format_number(points) +
+                               " points, at most 4294967295 (2^32 - 1) are supported; use a larger eta");
+  return points;
+}
+
+// Grid indices first..last of dimension i that a (validated) box contains, by the membership rule
+// of Grid::point_in_box (closed box, 1e-9*eta tolerance).
+std::pair<double, double> box_index_range(const Box& box, const GridSpec& states, std::size_t i) {
+  const double eta = states.eta[i];
+  const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
+  const double first = std::max(0.0, std::ceil((box.lb[i] - states.lb[i]) / eta - 1e-9));
+  const double last = std::min(count - 1, std::floor((box.ub[i] - states.lb[i]) / eta + 1e-9));
+  return {first, last};
+}
+
+// A cell in both boxes would silently become avoid (avoid wins in the roles): refuse it.
+void check_target_avoid_disjoint(const Box& target, const Box& avoid, const GridSpec& states) {
+  std::vector<double> shared;
+  for (std::size_t i = 0; i < states.lb.size(); ++i) {
+    const auto target_range = box_index_range(target, states, i);
+    const auto avoid_range = box_index_range(avoid, states, i);
+    const double first = std::max(target_range.first, avoid_range.first);
+    const double last = std::min(target_range.second, avoid_range.second);
+    if (first > last) return;
+    shared.push_back(states.lb[i] + first * states.eta[i]);
+  }
+  throw ConfigError("spec.avoid", "the avoid box " + format_list(avoid.lb) + " .. " + format_list(avoid.ub) +
+                                      " and the target box " + format_list(target.lb) + " .. " +
+                                      format_list(target.ub) + " share grid points, for example " +
+                                      format_list(shared) +
+                                      "; expected boxes without a common grid point (shrink one of them)");
+}
+
+void check_box(const Box& box, const std::string& key, const GridSpec& states) {
+  const std::string name = key.substr(key.rfind('.') + 1);
+  const std::string example = name + ": {lb: [5, 5], ub: [7, 7]}";
+  const std::size_t n = states.lb.size();
+  if (box.lb.size() != n)
+    fail(key + ".lb", std::to_string(box.lb.size()) + " values", std::to_string(n) + " values (one per state)", example);
+  if (box.ub.size() != n)
+    fail(key + ".ub", std::to_string(box.ub.size()) + " values", std::to_string(n) + " values (one per state)", example);
+  check_finite_list(box.lb, key + ".lb", example);
+  check_finite_list(box.ub, key + ".ub", example);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (box.lb[i] > box.ub[i])
+      fail(indexed(key + ".ub", i), format_number(box.ub[i]),
+           "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(box.lb[i]), example);
+    // Same membership rule as Grid::point_in_box: closed box with a 1e-9*eta tolerance.
+    const double eta = states.eta[i];
+    const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
+    const auto [first, last] = box_index_range(box, states, i);
+    if (first > last)
+      throw ConfigError(key, "the box " + format_list(box.lb) + " .. " + format_list(box.ub) +
+                                 " contains no representative point of the state grid in dimension " +
+                                 std::to_string(i) + " (points " + format_number(states.lb[i]) + ", " +
+                                 format_number(states.lb[i] + eta) + ", ..., " +
+                                 format_number(states.lb[i] + (count - 1) * eta) +
+                                 "); widen the box or refine states.eta (example: " + example + ")");
+  }
+}
+
+bool is_identifier(const std::string& name) {
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+bool looks_like_variable(const std::string& name) {
+  if (name.size() < 2 || std::string("xuw").find(name[0]) == std::string::npos) return false;
+  for (std::size_t i = 1; i < name.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
+  return true;
+}
+
+const std::vector<std::string> kFunctionNames = {"sin", "cos",  "tan", "asin", "acos", "atan",  "atan2", "exp", "log",
+                                                 "sqrt", "pow", "abs", "min", "max",  "floor", "ceil",  "if"};
+
+void check_integrator(const IntegratorConfig& integrator, bool expressions, std::size_t n) {
+  const char* const example = "integrator: {method: rk4, substeps: 4, tau: 0.1}";
+  if (integrator.substeps < 1 || integrator.substeps > kMaxIntegratorSubsteps)
+    fail("integrator.substeps", std::to_string(integrator.substeps),
+         "an integer in [1, " + std::to_string(kMaxIntegratorSubsteps) + "]", example);
+  if (integrator.tau && !(std::isfinite(*integrator.tau) && *integrator.tau > 0))
+    fail("integrator.tau", format_number(*integrator.tau), "a time step in seconds > 0", example);
+  if (expressions && !integrator.is_default() && !integrator.tau)
+    throw ConfigError("integrator.tau",
+                      "missing: with an integrator, `dynamics` are the vector field dx/dt and need the length of "
+                      "one time step in seconds (example: " + std::string(example) + ")");
+  const bool integrated = !expressions || integrator.tau;
+  if (integrated && n > kMaxIntegratorStates)
+    throw ConfigError("integrator", "an integrated model has at most " + std::to_string(kMaxIntegratorStates) +
+                                        " state dimensions, got " + std::to_string(n) +
+                                        "; give `dynamics` as the discrete map without `integrator`");
+}
+
+}  // namespace
+
+void Config::validate() const {
+  if (name.empty()) fail("name", "\"\"", "a non-empty name", "name: robot_reach_avoid");
+
+  const double state_points = check_grid(states, "states", "");
+  const std::size_t n = states.lb.size();
+  const std::size_t m = inputs ? inputs->lb.size() : 0;
+  const std::size_t p = disturbances ? disturbances->lb.size() : 0;
+  if (inputs) check_grid(*inputs, "inputs", "; omit `inputs` for an autonomous system");
+  if (disturbances) check_grid(*disturbances, "disturbances", "; omit `disturbances` when there are none");
+
+  for (const auto& constant : constants) {
+    const std::string key = "constants." + constant.first;
+    // z is the variable of noise densities.
+    bool reserved = constant.first == "pi" || constant.first == "z" || looks_like_variable(constant.first);
+    for (const auto& function : kFunctionNames) reserved = reserved || function == constant.first;
+    if (!is_identifier(constant.first) || reserved)
+      throw ConfigError(key, "got the name '" + constant.first +
+                                 "', expected a name of letters, digits and '_' that is not pi, a variable "
+                                 "(x0, u1, ..., z) or a function (example: constants: {tau: 10.0})");
+    if (!std::isfinite(constant.second)) fail(key, format_number(constant.second), "a finite number", "tau: 10.0");
+  }
+
+  if (!model.empty() && !dynamics.empty())
+    throw ConfigError("model", "both `model` and `dynamics` are given; use one (example: model: bmw320i)");
+  if (model.empty()) {
+    if (dynamics.empty())
+      throw ConfigError("dynamics", "missing, expected one expression per state dimension or a built-in `model` "
+                                    "(example: dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"])");
+    if (dynamics.size() != n)
+      fail("dynamics", std::to_string(dynamics.size()) + " expressions",
+           std::to_string(n) + ", one per state dimension (states.lb has " + std::to_string(n) + " values)",
+           "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]");
+    parse_dynamics(*this);
+  } else {
+    const BuiltinModelInfo* info = nullptr;
+    std::vector<std::string> names;
+    for (const auto& candidate : builtin_models()) {
+      names.push_back(candidate.name);
+      if (candidate.name == model) info = &candidate;
+    }
+    if (!info) fail("model", "'" + model + "'", "one of " + join(names), "model: bmw320i");
+    auto check_dims = [&](const char* key, std::size_t have, std::size_t want) {
+      if (have != want)
+        throw ConfigError(key, "model " + model + " needs " + std::to_string(want) + " dimensions, got " +
+                                   std::to_string(have) + " (" + info->description + ")");
+    };
+    check_dims("states.lb", n, info->state_dims);
+    check_dims("inputs.lb", m, info->input_dims);
+    check_dims("disturbances.lb", p, info->disturbance_dims);
+  }
+  check_integrator(integrator, model.empty(), n);
+
+  check_noise(noise, n, constants);
+
+  if (spec.unbounded) {
+    if (!(spec.tolerance > 0 && spec.tolerance < 1))
+      fail("spec.tolerance", format_number(spec.tolerance), "a number in (0, 1)", "tolerance: 1.0e-6");
+  } else if (spec.horizon == 0) {
+    fail("spec.horizon", "0", "an integer >= 1 (number of time steps) or infinite", "horizon: 16");
+  }
+  switch (spec.type) {
+    case SpecType::Safety:
+      if (spec.target) throw ConfigError("spec.target", "given for spec.type safety; safety uses `safe` (or the whole grid)");
+      if (spec.avoid) throw ConfigError("spec.avoid", "given for spec.type safety; use reach_avoid, or `safe` for the set to stay in");
+      if (spec.safe) check_box(*spec.safe, "spec.safe", states);
+      break;
+    case SpecType::Reachability:
+    case SpecType::ReachAvoid:
+      if (spec.safe) throw ConfigError("spec.safe", "given for spec.type " + to_string(spec.type) + "; `safe` is for safety only");
+      if (!spec.target)
+        throw ConfigError("spec.target", "missing, expected the target box for " + to_string(spec.type) +
+                                             " (example: target: {lb: [5, 5], ub: [7, 7]})");
+      check_box(*spec.target, "spec.target", states);
+      if (spec.avoid) {
+        if (spec.type == SpecType::Reachability)
+          throw ConfigError("spec.avoid", "given for spec.type reachability; use reach_avoid to avoid a set");
+        check_box(*spec.avoid, "spec.avoid", states);
+        check_target_avoid_disjoint(*spec.target, *spec.avoid, states);
+      }
+      break;
+  }
+
+  if (!(compute.memory_fraction > 0 && compute.memory_fraction <= 1))
+    fail("compute.memory_fraction", format_number(compute.memory_fraction), "a fraction in (0, 1]",
+         "memory_fraction: 0.5");
+
+  for (std::size_t i = 0; i < compute.devices.size(); ++i) {
+    const std::string& entry = compute.devices[i];
+    if (entry == "all") {
+      if (compute.devices.size() > 1)
+        fail(indexed("compute.devices", i), "'all' beside other devices", "`all` alone or a list of devices",
+             "devices: all");
+      continue;
+    }
+    if (!parse_device_selector(entry))
+      fail(indexed("compute.devices", i), "'" + entry + "'",
+           "gpu:N, cpu:N or P.D (--list-devices numbers), optionally /C to split it into sub-devices of C "
+           "compute units",
+           "devices: [gpu:0, gpu:1]");
+  }
+  if (!compute.devices.empty() && compute.device == DeviceKind::Reference)
+    fail("compute.devices", join(compute.devices), "no devices with compute.device: reference (it runs on the host)",
+         "device: auto");
+
+  // An unbounded policy is stored like one step (and its upper bound).
+  const double stored_steps = spec.unbounded ? 2.0 : double(spec.horizon);
+  const double policy_bytes = state_points * ((stored_steps + 1) * 8 + stored_steps * 4);
+  if (policy_bytes > kMaxPolicyBytes) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "grid too large: %.0f states x (%u+1 values x 8 bytes + %u inputs x 4 bytes) = %.1f GiB of "
+                  "policy arrays, more than the 16 GiB supported; use a larger states.eta or a shorter horizon",
+                  state_points, spec.horizon, spec.horizon, policy_bytes / (1024.0 * 1024 * 1024));
+    throw ConfigError("states", text);
+  }
+}
+
+}  // namespace amytiss

@@ -1,0 +1,261 @@
+// Interval iteration for unbounded specifications. Why it is sound (docs/semantics.md,
+// "Unbounded horizon"): the lower sequence starts below the value and the upper one above it, and
+// the Bellman operator is monotone with the value as a fixed point, so both stay on their side;
+// end-component corrections only use sets in which one player can keep the play, which bound
+// the value by the best exit; the stored policy's own value is iterated from below on the host.
+#include "host/interval_iteration.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "host/game_graph.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+constexpr unsigned kMaxIterations = 100000;
+// End components are looked for (on the host) every this many iterations.
+constexpr unsigned kCorrectionPeriod = 8;
+// Actions within this of a player's best count as its choices when end components are looked
+// for; only convergence depends on it, never soundness (any end component gives a valid bound).
+constexpr double kOptimalSlack = 1e-12;
+// The iteration aims at half the tolerance, leaving the other half to the certified policy.
+constexpr double kIterationShareOfTolerance = 0.5;
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+double largest_gap(const std::vector<double>& lower, const std::vector<double>& upper) {
+  double gap = 0;
+  for (std::size_t x = 0; x < lower.size(); ++x) gap = std::max(gap, upper[x] - lower[x]);
+  return gap;
+}
+
+// The state of the iteration between Bellman steps.
+struct Iteration {
+  const Abstraction& a;
+  GameSupports& supports;
+  ReferenceStep& host;
+  std::vector<char> candidate;       // cells of end components (with every action allowed)
+  std::vector<double> lower, upper;
+  std::vector<std::uint32_t> ec_input;     // safety: the input that keeps the play in its component
+  std::vector<double> ec_value;            // the value the correction gave that cell (-1: none)
+
+  // Reachability: an end component the adversary can keep the play in (using its choices that
+  // are optimal for the lower bound) is worth at most the controller's best way out.
+  bool deflate_upper() {
+    const std::size_t n = a.states.size();
+    std::vector<std::vector<double>> q(n);
+    for (std::size_t rank = 0; rank < supports.free_cells(); ++rank) {
+      const std::size_t x = supports.free_cell(rank);
+      if (!candidate[x]) continue;
+      q[x].resize(supports.inputs() * supports.disturbances());
+      for (std::size_t u = 0; u < supports.inputs(); ++u)
+        for (std::size_t w = 0; w < supports.disturbances(); ++w)
+          q[x][u * supports.disturbances() + w] = host.expected(x, u, w, lower.data());
+    }
+    const std::size_t W = supports.disturbances();
+    auto all_inputs = [](std::size_t, std::size_t) { return true; };
+    auto optimal_disturbance = [&](std::size_t x, std::size_t u, std::size_t w) {
+      const double* row = &q[x][u * W];
+      return row[w] <= *std::min_element(row, row + W) + kOptimalSlack;
+    };
+    const std::vector<std::int64_t> component = end_components(supports, n, candidate, all_inputs, optimal_disturbance);
+    std::vector<double> best_exit;
+    for (std::size_t rank = 0; rank < supports.free_cells(); ++rank) {
+      const std::size_t x = supports.free_cell(rank);
+      if (component[x] < 0) continue;
+      if (best_exit.size() <= std::size_t(component[x])) best_exit.resize(std::size_t(component[x]) + 1, 0.0);
+      for (std::size_t u = 0; u < supports.inputs(); ++u) {
+        bool stays = false;
+        for (std::size_t w = 0; w < W && !stays; ++w)
+          stays = optimal_disturbance(x, u, w) && row_stays(supports, component, rank, u, w);
+        if (!stays) best_exit[component[x]] = std::max(best_exit[component[x]], host.input_value(x, u, upper.data()));
+      }
+    }
+    bool changed = false;
+    for (std::size_t x = 0; x < n; ++x)
+      if (component[x] >= 0 && best_exit[component[x]] < upper[x]) {
+        upper[x] = best_exit[component[x]];
+        changed = true;
+      }
+    return changed;
+  }
+
+  // Safety: an end component the controller can keep the play in (with its inputs optimal for
+  // the upper bound) is worth at least the disturbance's worst way out (1 without one).
+  bool inflate_lower() {
+    const std::size_t n = a.states.size();
+    std::vector<std::vector<double>> q(n);
+    for (std::size_t rank = 0; rank < supports.free_cells(); ++rank) {
+      const std::size_t x = supports.free_cell(rank);
+      if (!candidate[x]) continue;
+      q[x].resize(supports.inputs());
+      for (std::size_t u = 0; u < supports.inputs(); ++u) q[x][u] = host.input_value(x, u, upper.data());
+    }
+    auto optimal_input = [&](std::size_t x, std::size_t u) {
+      return q[x][u] >= *std::max_element(q[x].begin(), q[x].end()) - kOptimalSlack;
+    };
+    auto all_rows = [](std::size_t, std::size_t, std::size_t) { return true; };
+    const std::vector<std::int64_t> component = end_components(supports, n, candidate, optimal_input, all_rows);
+    std::vector<double> worst_exit;
+    for (std::size_t rank = 0; rank < supports.free_cells(); ++rank) {
+      const std::size_t x = supports.free_cell(rank);
+      if (component[x] < 0) continue;
+      if (worst_exit.size() <= std::size_t(component[x])) worst_exit.resize(std::size_t(component[x]) + 1, 1.0);
+      bool input_found = false;
+      for (std::size_t u = 0; u < supports.inputs(); ++u) {
+        if (!optimal_input(x, u)) continue;
+        std::vector<char> stays(supports.disturbances());
+        bool any = false;
+        for (std::size_t w = 0; w < supports.disturbances(); ++w)
+          any |= stays[w] = row_stays(supports, component, rank, u, w);
+        if (!any) continue;
+        if (!input_found) ec_input[x] = std::uint32_t(u), input_found = true;
+        for (std::size_t w = 0; w < supports.disturbances(); ++w)
+          if (!stays[w])
+            worst_exit[component[x]] = std::min(worst_exit[component[x]], host.expected(x, u, w, lower.data()));
+      }
+    }
+    bool changed = false;
+    for (std::size_t x = 0; x < n; ++x)
+      if (component[x] >= 0 && worst_exit[component[x]] > lower[x]) {
+        lower[x] = ec_value[x] = worst_exit[component[x]];
+        changed = true;
+      }
+    return changed;
+  }
+};
+
+}  // namespace
+
+Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& host, const UnboundedRun& run,
+                       SynthesisReport& report) {
+  const std::size_t n = a.states.size();
+  const bool reach = a.spec != SpecType::Safety;
+  auto phase_start = Clock::now();
+  GameSupports supports(a);
+  Iteration it{a, supports, host, std::vector<char>(n, 0), std::vector<double>(n, 0.0), std::vector<double>(n, 0.0),
+               std::vector<std::uint32_t>(n, 0), std::vector<double>(n, -1.0)};
+  for (std::size_t x = 0; x < n; ++x) {
+    it.lower[x] = a.roles[x] == CellRole::FixedOne ? 1.0 : 0.0;
+    it.upper[x] = a.roles[x] == CellRole::FixedZero ? 0.0 : 1.0;
+  }
+  // Attractors: the value is exactly 0 outside the controller's positive attractor of the target,
+  // and exactly 1 where it can stay safe surely.
+  std::vector<std::uint32_t> sure_input;
+  std::vector<char> sure_safe(n, 0);
+  if (reach) {
+    const std::vector<char> attractor = positive_attractor(a, supports);
+    for (std::size_t x = 0; x < n; ++x) {
+      if (!attractor[x]) it.upper[x] = 0.0;
+      it.candidate[x] = attractor[x] && a.roles[x] == CellRole::Free;
+    }
+  } else {
+    sure_safe = sure_safe_set(a, supports, sure_input);
+    for (std::size_t x = 0; x < n; ++x) {
+      if (sure_safe[x]) it.lower[x] = 1.0;
+      it.candidate[x] = !sure_safe[x] && a.roles[x] == CellRole::Free;
+    }
+  }
+  const std::vector<double> initial_lower = it.lower;
+  auto every_input = [](std::size_t, std::size_t) { return true; };
+  auto every_row = [](std::size_t, std::size_t, std::size_t) { return true; };
+  const std::vector<std::int64_t> any_component = end_components(supports, n, it.candidate, every_input, every_row);
+  std::size_t component_cells = 0;
+  for (std::size_t x = 0; x < n; ++x) {
+    it.candidate[x] = any_component[x] >= 0;
+    component_cells += it.candidate[x];
+  }
+  report.phases.push_back({"graph analysis", seconds_since(phase_start), 0, 0});
+  report.notes.push_back(
+      {NoteSeverity::Info, NoteKind::Convergence,
+       component_cells == 0 ? std::string("unbounded: no end components among the undecided cells (the play leaves "
+                                          "them with probability 1): plain interval iteration")
+                            : "unbounded: " + std::to_string(component_cells) +
+                                  " cells in end components, corrected on the host every " +
+                                  std::to_string(kCorrectionPeriod) + " iterations"});
+
+  // --- interval iteration
+  phase_start = Clock::now();
+  std::vector<std::uint32_t> policy_input(n, 0), upper_input(n, 0);
+  std::vector<double> next(n);
+  unsigned iterations = 0;
+  double gap = largest_gap(it.lower, it.upper);
+  std::vector<std::uint32_t> lower_input(n, 0);
+  while (gap > kIterationShareOfTolerance * a.tolerance && iterations < kMaxIterations) {
+    bool moved = false;
+    step.apply(it.lower.data(), next.data(), lower_input.data());
+    for (std::size_t x = 0; x < n; ++x) {
+      // The input changes only when the lower bound grows by more than the step's rounding: an
+      // input that is merely as good (a way to stay in an end component) makes no progress.
+      if (next[x] > it.lower[x] + step.resolution()) policy_input[x] = lower_input[x];
+      if (next[x] > it.lower[x]) it.lower[x] = next[x], moved = true;
+    }
+    step.apply(it.upper.data(), next.data(), upper_input.data());
+    for (std::size_t x = 0; x < n; ++x)
+      if (next[x] < it.upper[x]) it.upper[x] = next[x], moved = true;
+    ++iterations;
+    if (component_cells > 0 && iterations % kCorrectionPeriod == 0)
+      moved |= reach ? it.deflate_upper() : it.inflate_lower();
+    gap = largest_gap(it.lower, it.upper);
+    if (run.on_iteration) run.on_iteration(iterations, gap);
+    // Neither sequence moves (and the corrections found nothing): the gap cannot close.
+    if (!moved && (component_cells == 0 || iterations % kCorrectionPeriod == 0)) break;
+  }
+  report.phases.push_back({"interval iteration (" + std::to_string(iterations) + " iterations)",
+                           seconds_since(phase_start), 0, step.multiply_adds() * 2.0 * iterations});
+
+  // --- the stationary policy: greedy for the lower bound, the sure input where safety is sure,
+  // the component's input where a correction set the lower bound; its value from below.
+  phase_start = Clock::now();
+  for (std::size_t x = 0; x < n; ++x) {
+    if (sure_safe[x]) policy_input[x] = sure_input[x];
+    else if (it.ec_value[x] >= 0 && it.lower[x] <= it.ec_value[x]) policy_input[x] = it.ec_input[x];
+  }
+  std::vector<double> certified = initial_lower;
+  unsigned certification_steps = 0;
+  double certified_gap = largest_gap(certified, it.upper);
+  while (certified_gap > a.tolerance && certification_steps < 2 * iterations + 100) {
+    host.apply_fixed(certified.data(), next.data(), policy_input.data());
+    bool moved = false;
+    for (std::size_t x = 0; x < n; ++x)
+      if (next[x] > certified[x]) certified[x] = next[x], moved = true;
+    ++certification_steps;
+    certified_gap = largest_gap(certified, it.upper);
+    if (!moved) break;
+  }
+  report.phases.push_back({"policy certification (" + std::to_string(certification_steps) + " steps)",
+                           seconds_since(phase_start), 0, 0});
+  const std::string summary = "unbounded: " + std::to_string(iterations) + " iterations, upper - lower <= " +
+                              number(gap) + " for the optimal value; the stationary policy guarantees a value " +
+                              "within " + number(certified_gap) + " of the upper bound (tolerance " +
+                              number(a.tolerance) + ")";
+  report.notes.push_back({certified_gap <= a.tolerance ? NoteSeverity::Info : NoteSeverity::Warning, NoteKind::Convergence,
+                          certified_gap <= a.tolerance ? summary : summary + ": the tolerance was not reached"});
+
+  Policy policy;
+  policy.states = a.states;
+  policy.inputs = a.inputs;
+  policy.horizon = 1;
+  policy.stationary = true;
+  policy.roles = a.roles;
+  policy.computed_by = run.device_label;
+  policy.config_hash = config_hash(a.config);
+  policy.values = certified;
+  policy.values.insert(policy.values.end(), certified.begin(), certified.end());
+  policy.input_index = policy_input;
+  policy.upper_values = it.upper;
+  policy.iterations = iterations;
+  policy.gap = certified_gap;
+  return policy;
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,16 @@
+/* The storage class of the built-in model functions, shared by every header in this folder.
+ * Valid as C++ and as OpenCL C: model/model.cpp includes it before the models, and
+ * BuiltinDynamics::opencl_source() puts its text before the model's. OpenCL C: plain functions;
+ * C and C++: static inline (one private copy per translation unit). */
+#ifndef AMYTISS_MODEL_FUNCTION_H
+#define AMYTISS_MODEL_FUNCTION_H
+
+#ifndef AMYTISS_MODEL_FUNCTION
+#ifdef __OPENCL_VERSION__
+#define AMYTISS_MODEL_FUNCTION
+#else
+#define AMYTISS_MODEL_FUNCTION static inline
+#endif
+#endif
+
+#endif

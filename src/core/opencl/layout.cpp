@@ -1,0 +1,75 @@
+#include "opencl/layout.hpp"
+
+#include <algorithm>
+#include <cstdint>
+
+#include "amytiss/engine.hpp"
+
+namespace amytiss {
+namespace detail {
+
+Layout::Layout(const Abstraction& a) {
+  const std::size_t dims = a.states.dims();
+  const auto& h = a.noise->window_half_cells();
+  half.resize(dims);
+  width.resize(dims);
+  mass_offset.resize(dims);
+  padded_count.resize(dims);
+  padded_stride.resize(dims);
+  whole.resize(dims);
+  for (std::size_t i = 0; i < dims; ++i) {
+    const long long count = static_cast<long long>(a.states.count(i));
+    whole[i] = a.noise->whole_grid_dims()[i] ? 1 : 0;
+    // A whole-grid window is the dimension itself: no padding, n cells from index 0 (padding
+    // by n - 1 on each side would make the value array (3n - 2)^d: 2^28 cells for StocHy 14-d).
+    // Otherwise the window never needs more than the grid: h <= n - 1 bounds the padding.
+    half[i] = whole[i] ? 0 : std::min<long long>(h[i], count - 1);
+    width[i] = whole[i] ? count : 2 * half[i] + 1;
+    mass_offset[i] = mass_record;
+    mass_record += width[i];
+    padded_count[i] = count + 2 * half[i];
+  }
+  for (std::size_t i = dims; i-- > 0;) {
+    padded_stride[i] = static_cast<long long>(padded_size);
+    padded_size *= static_cast<std::size_t>(padded_count[i]);
+  }
+}
+
+std::size_t Layout::padded_offset(const Grid& states, std::size_t flat) const {
+  std::size_t offset = 0;
+  for (std::size_t i = states.dims(); i-- > 0;) {
+    const std::size_t k = flat % states.count(i);
+    flat /= states.count(i);
+    offset += (k + static_cast<std::size_t>(half[i])) * static_cast<std::size_t>(padded_stride[i]);
+  }
+  return offset;
+}
+
+std::size_t Layout::record_bytes() const {
+  return sizeof(std::uint32_t) + sizeof(float) * static_cast<std::size_t>(mass_record);
+}
+
+double contraction_multiply_adds(const Abstraction& abstraction) {
+  const Layout layout(abstraction);
+  double total = 0, product = 1;
+  for (long long width : layout.width) {
+    product *= double(width);
+    total += product;
+  }
+  return total;
+}
+
+}  // namespace detail
+
+MemoryEstimate estimate_memory(const Abstraction& abstraction) {
+  const double cells = double(abstraction.states.size());
+  const double horizon = double(abstraction.horizon);
+  MemoryEstimate estimate;
+  estimate.policy_bytes = (horizon + 1) * cells * sizeof(double) + horizon * cells * sizeof(std::uint32_t) +
+                          cells * sizeof(std::uint8_t);
+  estimate.bytes_per_triple = double(detail::Layout(abstraction).record_bytes());
+  estimate.stored_transition_bytes = estimate.bytes_per_triple * double(abstraction.triples());
+  return estimate;
+}
+
+}  // namespace amytiss
