@@ -11,7 +11,7 @@ add_library(amytiss_ros
   src/ros/synthesizer_monitor.cpp)
 target_include_directories(amytiss_ros PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/src/ros ${catkin_INCLUDE_DIRS})
 target_link_libraries(amytiss_ros PUBLIC amytiss_core ${catkin_LIBRARIES})
-add_dependencies(amytiss_ros ${catkin_EXPORTED_TARGETS})
+add_dependencies(amytiss_ros ${${PROJECT_NAME}_EXPORTED_TARGETS} ${catkin_EXPORTED_TARGETS})
 set_target_properties(amytiss_ros PROPERTIES POSITION_INDEPENDENT_CODE ON)
 # The plant simulator runs the plot script with the interpreter catkin was configured with.
 target_compile_definitions(amytiss_ros PRIVATE AMYTISS_PYTHON_EXECUTABLE="${PYTHON_EXECUTABLE}")

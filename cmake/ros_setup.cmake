@@ -1,10 +1,14 @@
-# ROS part 1: catkin and catkin_package(). Included before the core. The messages, the service
-# and the action are in the separate package amytiss_msgs (amytiss_msgs/ in this repository).
+# ROS part 1: catkin, the package's messages, service and action (msg/, srv/, action/), and
+# catkin_package(). Included before the core.
 find_package(catkin REQUIRED COMPONENTS
-  roscpp std_msgs geometry_msgs visualization_msgs actionlib actionlib_msgs diagnostic_updater amytiss_msgs)
+  roscpp std_msgs geometry_msgs visualization_msgs actionlib actionlib_msgs diagnostic_updater message_generation)
 
-catkin_package(
-  INCLUDE_DIRS include
-  LIBRARIES amytiss_core
-  CATKIN_DEPENDS roscpp std_msgs geometry_msgs visualization_msgs actionlib actionlib_msgs diagnostic_updater
-                 amytiss_msgs)
+add_message_files(DIRECTORY msg)
+add_service_files(DIRECTORY srv)
+add_action_files(DIRECTORY action)
+generate_messages(DEPENDENCIES std_msgs actionlib_msgs)
+
+# A client of this package gets the messages, the service and the action, and nothing of the
+# core: no library and no include folder are exported, so a client that only calls the service
+# links neither OpenCL nor HDF5 (scripts/test_install checks it against the install space).
+catkin_package(CATKIN_DEPENDS message_runtime std_msgs actionlib_msgs)

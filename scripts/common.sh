@@ -1,7 +1,6 @@
 # Shared by scripts/test and scripts/demo (sourced, not run).
-# The catkin workspace lives in .ws/ at the repository root (AMYTISS_WS overrides); the two
-# packages (amytiss at the root, amytiss_msgs in amytiss_msgs/) are linked into its src/ so the
-# checkout itself is what gets built (catkin does not look for packages inside a package).
+# The catkin workspace lives in .ws/ at the repository root (AMYTISS_WS overrides); the package
+# (the repository root) is linked into its src/ so the checkout itself is what gets built.
 AMYTISS_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 AMYTISS_WS=${AMYTISS_WS:-$AMYTISS_ROOT/.ws}
 # ROS tools need Debian's python3 (a pyenv python3 may come first on PATH and lacks catkin).
@@ -16,7 +15,8 @@ amytiss_install() {
 amytiss_workspace() {
   mkdir -p "$AMYTISS_WS/src" "$ROS_HOME"
   amytiss_link "$AMYTISS_WS/src/amytiss" "$AMYTISS_ROOT"
-  amytiss_link "$AMYTISS_WS/src/amytiss_msgs" "$AMYTISS_ROOT/amytiss_msgs"
+  # A workspace made when the messages were a package of their own still links it.
+  if [ -L "$AMYTISS_WS/src/amytiss_msgs" ]; then rm -f "$AMYTISS_WS/src/amytiss_msgs"; fi
 }
 
 amytiss_link() {

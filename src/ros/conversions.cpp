@@ -45,14 +45,14 @@ void name_policy(const amytiss::Policy* policy, Answer& answer) {
 
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
                              unsigned time_step, const std::string& server_notice,
-                             amytiss_msgs::GetInput::Response& response) {
+                             amytiss::GetInput::Response& response) {
   response.success = answer_state(policy, state, time_step, server_notice, response.input, response.probability,
                                   response.message);
   name_policy(policy, response);
 }
 
-void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::StateStamped& state,
-                        const std::string& server_notice, amytiss_msgs::InputCommand& command) {
+void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
+                        const std::string& server_notice, amytiss::InputCommand& command) {
   command.header.stamp = state.header.stamp;
   command.header.frame_id = state.header.frame_id;
   command.time_step = state.time_step;
@@ -61,8 +61,8 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::State
   name_policy(policy, command);
 }
 
-amytiss_msgs::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
-  amytiss_msgs::SynthesizeFeedback feedback;
+amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
+  amytiss::SynthesizeFeedback feedback;
   feedback.phase = amytiss::to_string(progress.phase);
   feedback.percent = progress.percent();
   feedback.steps_done = progress.steps_done;

@@ -2,11 +2,11 @@
 // Conversions between core types and amytiss messages. Pure functions: no node, no master.
 #include <string>
 
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/InputCommand.h>
-#include <amytiss_msgs/PolicyStatus.h>
-#include <amytiss_msgs/StateStamped.h>
-#include <amytiss_msgs/SynthesizeFeedback.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/PolicyStatus.h>
+#include <amytiss/StateStamped.h>
+#include <amytiss/SynthesizeFeedback.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "amytiss/config.hpp"
@@ -25,14 +25,14 @@ namespace amytiss_ros {
 /// Allocation: only the response's vector and strings (they reuse their capacity).
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
                              unsigned time_step, const std::string& server_notice,
-                             amytiss_msgs::GetInput::Response& response);
+                             amytiss::GetInput::Response& response);
 
 /// The same for the closed loop: answers `state` into `command` (header and time_step copied).
-void fill_input_command(const amytiss::Policy* policy, const amytiss_msgs::StateStamped& state,
-                        const std::string& server_notice, amytiss_msgs::InputCommand& command);
+void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
+                        const std::string& server_notice, amytiss::InputCommand& command);
 
 /// Action feedback from engine progress.
-amytiss_msgs::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
+amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
 
 /// "synthesis 42% (step 7/16) on reference, about 3.1 s left" for status and logs.
 std::string describe_progress(const amytiss::Progress& progress);

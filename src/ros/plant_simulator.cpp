@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include <amytiss_msgs/StateStamped.h>
+#include <amytiss/StateStamped.h>
 #include <visualization_msgs/Marker.h>
 
 #include "amytiss/policy_file.hpp"
@@ -25,22 +25,22 @@ namespace amytiss_ros {
 
 PlantSimulatorNode::PlantSimulatorNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle)
     : public_handle_(public_handle), private_handle_(private_handle) {
-  state_publisher_ = public_handle_.advertise<amytiss_msgs::StateStamped>("state", 10);
-  summary_publisher_ = public_handle_.advertise<amytiss_msgs::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
+  state_publisher_ = public_handle_.advertise<amytiss::StateStamped>("state", 10);
+  summary_publisher_ = public_handle_.advertise<amytiss::EpisodeSummary>("episode_summary", 1, /*latch=*/true);
   car_publisher_ = public_handle_.advertise<visualization_msgs::Marker>("car_marker", 10);
   status_subscriber_ = public_handle_.subscribe("status", 10, &PlantSimulatorNode::on_status, this);
   command_subscriber_ = public_handle_.subscribe("command", 10, &PlantSimulatorNode::on_command, this,
                                                  ros::TransportHints().tcpNoDelay());
 }
 
-void PlantSimulatorNode::on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status) {
+void PlantSimulatorNode::on_status(const amytiss::PolicyStatus::ConstPtr& status) {
   if (!status->ready) return;
   std::lock_guard<std::mutex> lock(mutex_);
   ready_status_ = status;
   changed_.notify_all();
 }
 
-void PlantSimulatorNode::on_command(const amytiss_msgs::InputCommand::ConstPtr& command) {
+void PlantSimulatorNode::on_command(const amytiss::InputCommand::ConstPtr& command) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_command_ = command;
   changed_.notify_all();
@@ -115,7 +115,7 @@ int PlantSimulatorNode::run() {
     output_dir = std::filesystem::path(default_policy_path("x")).parent_path().string() + "/episodes";
 
   ROS_INFO("plant simulator: waiting for a policy on %s", status_subscriber_.getTopic().c_str());
-  amytiss_msgs::PolicyStatus::ConstPtr status;
+  amytiss::PolicyStatus::ConstPtr status;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, std::chrono::duration<double>(policy_timeout_s),
@@ -171,7 +171,7 @@ int PlantSimulatorNode::run() {
   csv << ",probability,success\n";
   csv.precision(10);
 
-  amytiss_msgs::EpisodeSummary summary;
+  amytiss::EpisodeSummary summary;
   summary.initial_state = initial_state;
   summary.predicted_probability = predicted;
   ros::Time last_stamp;
@@ -188,12 +188,12 @@ int PlantSimulatorNode::run() {
         rows.push_back(csv_row(episode, step, state, {}, policy.inputs.dims(), std::nan("")));
         break;
       }
-      amytiss_msgs::InputCommand::ConstPtr command;
+      amytiss::InputCommand::ConstPtr command;
       // The server loads the policy after the status says ready: until then it answers "no policy
       // yet", and the state is sent again (bounded by policy_timeout_s).
       const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(policy_timeout_s);
       for (;;) {
-        amytiss_msgs::StateStamped message;
+        amytiss::StateStamped message;
         message.header.stamp = ros::Time::now();
         if (message.header.stamp <= last_stamp) message.header.stamp = last_stamp + ros::Duration(0, 1);
         last_stamp = message.header.stamp;

@@ -2,12 +2,12 @@
 // The plant simulator node's logic: closes the loop through the policy server's topics.
 //
 // Waits for a ready policy on /amytiss/status, reads its file (configuration and V_0 inside),
-// then runs ~episodes episodes from ~initial_state: publish amytiss_msgs/StateStamped on state, wait
-// for the matching amytiss_msgs/InputCommand on command, step the plant (PlantModel), until the
+// then runs ~episodes episodes from ~initial_state: publish amytiss/StateStamped on state, wait
+// for the matching amytiss/InputCommand on command, step the plant (PlantModel), until the
 // target, the avoid set / outside the safe set, leaving the grid, or the horizon. Logs each
 // outcome and, at the end, the empirical success rate next to V_0 of the start state; writes a
 // CSV of the trajectories and pictures (scripts/plot_episodes.py) into ~output_dir; publishes a
-// latched amytiss_msgs/EpisodeSummary on episode_summary.
+// latched amytiss/EpisodeSummary on episode_summary.
 // Private parameters: initial_state (list, state units, required), episodes (int, 20), seed
 // (int, 1), output_dir (string, default $ROS_HOME/amytiss/episodes), plot_script (string, empty:
 // no pictures), python (string, default: the Python catkin was configured with), command_timeout_s (5), policy_timeout_s
@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include <amytiss_msgs/EpisodeSummary.h>
-#include <amytiss_msgs/InputCommand.h>
-#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss/EpisodeSummary.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/PolicyStatus.h>
 #include <ros/ros.h>
 
 namespace amytiss_ros {
@@ -37,8 +37,8 @@ class PlantSimulatorNode {
   int run();
 
  private:
-  void on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status);
-  void on_command(const amytiss_msgs::InputCommand::ConstPtr& command);
+  void on_status(const amytiss::PolicyStatus::ConstPtr& status);
+  void on_command(const amytiss::InputCommand::ConstPtr& command);
 
   ros::NodeHandle public_handle_, private_handle_;
   ros::Publisher state_publisher_, summary_publisher_, car_publisher_;
@@ -46,8 +46,8 @@ class PlantSimulatorNode {
 
   std::mutex mutex_;
   std::condition_variable changed_;
-  amytiss_msgs::PolicyStatus::ConstPtr ready_status_;
-  amytiss_msgs::InputCommand::ConstPtr last_command_;
+  amytiss::PolicyStatus::ConstPtr ready_status_;
+  amytiss::InputCommand::ConstPtr last_command_;
 };
 
 }  // namespace amytiss_ros

@@ -27,7 +27,7 @@ PolicyServerNode::PolicyServerNode(ros::NodeHandle public_handle, ros::NodeHandl
       monitor_(timeout_parameter(private_handle)),
       diagnostics_(public_handle, private_handle) {
   private_handle_.param<std::string>("frame_id", frame_id_, "map");
-  command_publisher_ = public_handle_.advertise<amytiss_msgs::InputCommand>("command", 10);
+  command_publisher_ = public_handle_.advertise<amytiss::InputCommand>("command", 10);
   marker_publisher_ = public_handle_.advertise<visualization_msgs::MarkerArray>("markers", 1, /*latch=*/true);
   std::string initial_file;
   private_handle_.param<std::string>("policy_file", initial_file, "");
@@ -77,15 +77,15 @@ std::string PolicyServerNode::notice(bool have_policy) const {
                      : monitor_.no_policy_reason(wall_now(), publishers);
 }
 
-bool PolicyServerNode::on_get_input(amytiss_msgs::GetInput::Request& request,
-                                    amytiss_msgs::GetInput::Response& response) {
+bool PolicyServerNode::on_get_input(amytiss::GetInput::Request& request,
+                                    amytiss::GetInput::Response& response) {
   const std::shared_ptr<const amytiss::Policy> policy = std::atomic_load(&policy_);
   fill_get_input_response(policy.get(), request.state, request.time_step, notice(policy != nullptr), response);
   // Malformed requests are answered (success false), never refused: the caller gets the message.
   return true;
 }
 
-void PolicyServerNode::on_state(const amytiss_msgs::StateStamped::ConstPtr& state) {
+void PolicyServerNode::on_state(const amytiss::StateStamped::ConstPtr& state) {
   const std::shared_ptr<const amytiss::Policy> policy = std::atomic_load(&policy_);
   const std::string server_notice = notice(policy != nullptr);
   std::lock_guard<std::mutex> lock(command_mutex_);
@@ -93,7 +93,7 @@ void PolicyServerNode::on_state(const amytiss_msgs::StateStamped::ConstPtr& stat
   command_publisher_.publish(command_);
 }
 
-void PolicyServerNode::on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status) {
+void PolicyServerNode::on_status(const amytiss::PolicyStatus::ConstPtr& status) {
   {
     std::lock_guard<std::mutex> lock(monitor_mutex_);
     monitor_.on_status(*status, wall_now());

@@ -2,10 +2,10 @@
 // The policy server node's logic (the node's main() only constructs it and spins).
 //
 // Interface (relative to the public node handle, /amytiss in the launch files):
-//   service get_input (amytiss_msgs/GetInput)          state + step -> input + probability
-//   topic   state     (amytiss_msgs/StateStamped, in)   closed loop: each state is answered on
-//   topic   command   (amytiss_msgs/InputCommand, out)  with the same stamp and time step
-//   topic   status    (amytiss_msgs/PolicyStatus, in)   loads policy_file when ready and
+//   service get_input (amytiss/GetInput)          state + step -> input + probability
+//   topic   state     (amytiss/StateStamped, in)   closed loop: each state is answered on
+//   topic   command   (amytiss/InputCommand, out)  with the same stamp and time step
+//   topic   status    (amytiss/PolicyStatus, in)   loads policy_file when ready and
 //                                                       (config_hash, run_id) differs from the
 //                                                       policy served; its heartbeat tells
 //                                                       whether the synthesizer still runs
@@ -21,10 +21,10 @@
 #include <string>
 #include <thread>
 
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/InputCommand.h>
-#include <amytiss_msgs/PolicyStatus.h>
-#include <amytiss_msgs/StateStamped.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/PolicyStatus.h>
+#include <amytiss/StateStamped.h>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
@@ -44,9 +44,9 @@ class PolicyServerNode {
   bool load(const std::string& path);
 
  private:
-  bool on_get_input(amytiss_msgs::GetInput::Request& request, amytiss_msgs::GetInput::Response& response);
-  void on_state(const amytiss_msgs::StateStamped::ConstPtr& state);
-  void on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status);
+  bool on_get_input(amytiss::GetInput::Request& request, amytiss::GetInput::Response& response);
+  void on_state(const amytiss::StateStamped::ConstPtr& state);
+  void on_status(const amytiss::PolicyStatus::ConstPtr& status);
   /// The notice for an answer: why there is no policy, or a warning when the synthesizer stopped.
   std::string notice(bool have_policy) const;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -66,7 +66,7 @@ class PolicyServerNode {
   std::string requested_identity_;  // "<config_hash> <run_id>" of the last load started
 
   std::mutex command_mutex_;
-  amytiss_msgs::InputCommand command_;  // reused: its input vector keeps its capacity
+  amytiss::InputCommand command_;  // reused: its input vector keeps its capacity
 
   std::mutex loader_mutex_;
   std::thread loader_thread_;

@@ -35,10 +35,10 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
       private_handle_(private_handle),
       diagnostics_(public_handle, private_handle),
       action_server_(public_handle, "synthesize",
-                     [this](const amytiss_msgs::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
-  status_publisher_ = public_handle_.advertise<amytiss_msgs::PolicyStatus>("status", 1, /*latch=*/true);
-  update_status([](amytiss_msgs::PolicyStatus& status) {
-    status.phase = amytiss_msgs::PolicyStatus::PHASE_IDLE;
+                     [this](const amytiss::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
+  status_publisher_ = public_handle_.advertise<amytiss::PolicyStatus>("status", 1, /*latch=*/true);
+  update_status([](amytiss::PolicyStatus& status) {
+    status.phase = amytiss::PolicyStatus::PHASE_IDLE;
     status.remaining_s = -1;
     status.message = "synthesizer started";
   });
@@ -48,7 +48,7 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
   // keeps beating while a synthesis occupies the worker thread.
   heartbeat_timer_ = public_handle_.createWallTimer(ros::WallDuration(heartbeat_period_s),
                                                     [this](const ros::WallTimerEvent&) {
-                                                      update_status([](amytiss_msgs::PolicyStatus&) {});
+                                                      update_status([](amytiss::PolicyStatus&) {});
                                                       diagnostics_.update();
                                                     });
   diagnostics_.setHardwareID("amytiss");
@@ -58,8 +58,8 @@ SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle 
 void SynthesizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& diagnostic) {
   std::lock_guard<std::mutex> lock(status_mutex_);
   using diagnostic_msgs::DiagnosticStatus;
-  const unsigned char level = status_.phase == amytiss_msgs::PolicyStatus::PHASE_ERROR       ? DiagnosticStatus::ERROR
-                              : status_.phase == amytiss_msgs::PolicyStatus::PHASE_CANCELLED ? DiagnosticStatus::WARN
+  const unsigned char level = status_.phase == amytiss::PolicyStatus::PHASE_ERROR       ? DiagnosticStatus::ERROR
+                              : status_.phase == amytiss::PolicyStatus::PHASE_CANCELLED ? DiagnosticStatus::WARN
                                                                                              : DiagnosticStatus::OK;
   diagnostic.summary(level, status_.phase + ": " + status_.message);
   diagnostic.add("policy ready", bool(status_.ready));
@@ -107,7 +107,7 @@ std::string SynthesizerNode::policy_path_for(const amytiss::Config& config) cons
   return std::filesystem::absolute(path).lexically_normal().string();
 }
 
-void SynthesizerNode::update_status(const std::function<void(amytiss_msgs::PolicyStatus&)>& edit) {
+void SynthesizerNode::update_status(const std::function<void(amytiss::PolicyStatus&)>& edit) {
   std::lock_guard<std::mutex> lock(status_mutex_);
   edit(status_);
   status_.header.stamp = ros::Time::now();
@@ -124,9 +124,9 @@ SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<am
     Outcome outcome;
     outcome.message = std::string("invalid configuration: ") + error.what();
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
-    update_status([&](amytiss_msgs::PolicyStatus& status) {
+    update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
@@ -144,14 +144,14 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
   } catch (const std::exception& error) {
     outcome.message = std::string("bad policy_file parameter: ") + error.what();
     ROS_ERROR("%s", outcome.message.c_str());
-    update_status([&](amytiss_msgs::PolicyStatus& status) {
-      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
+    update_status([&](amytiss::PolicyStatus& status) {
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.message = outcome.message;
     });
     return outcome;
   }
   const auto announce = [&](const amytiss::Policy& policy, const std::string& phase) {
-    update_status([&](amytiss_msgs::PolicyStatus& status) {
+    update_status([&](amytiss::PolicyStatus& status) {
       status.ready = true;
       status.synthesizing = false;
       status.percent = 100.0;
@@ -165,7 +165,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       status.horizon = policy.horizon;
       status.run_id = policy.run_id;
       status.generation += 1;
-      if (phase == amytiss_msgs::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
+      if (phase == amytiss::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
     });
   };
 
@@ -177,7 +177,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
       outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name +
                         "' unchanged, hash " + hash + "); nothing to synthesize";
       ROS_INFO("%s", outcome.message.c_str());
-      announce(loaded.policy, amytiss_msgs::PolicyStatus::PHASE_REUSED);
+      announce(loaded.policy, amytiss::PolicyStatus::PHASE_REUSED);
       return outcome;
     } catch (const amytiss::PolicyFileError& error) {
       ROS_WARN("not reusing %s: %s; computing it again", outcome.policy_file.c_str(), error.what());
@@ -186,10 +186,10 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
 
   ROS_INFO("synthesizing '%s' (hash %s, horizon %u) on device %s -> %s", config.name.c_str(), hash.c_str(),
            config.spec.horizon, device.c_str(), outcome.policy_file.c_str());
-  update_status([&](amytiss_msgs::PolicyStatus& status) {
+  update_status([&](amytiss::PolicyStatus& status) {
     status.synthesizing = true;
     status.percent = 0.0;
-    status.phase = amytiss_msgs::PolicyStatus::PHASE_SETUP;
+    status.phase = amytiss::PolicyStatus::PHASE_SETUP;
     status.device = device;
     status.remaining_s = -1;
     status.message = "synthesizing '" + config.name + "' on " + device;
@@ -202,7 +202,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     options.progress = [&](const amytiss::Progress& progress) {
       const std::string text = describe_progress(progress);
       ROS_INFO("%s", text.c_str());
-      update_status([&](amytiss_msgs::PolicyStatus& status) {
+      update_status([&](amytiss::PolicyStatus& status) {
         status.synthesizing = true;
         status.percent = progress.percent();
         status.phase = amytiss::to_string(progress.phase);
@@ -235,22 +235,22 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     outcome.success = true;
     outcome.message = text;
     ROS_INFO("%s", text);
-    announce(policy, amytiss_msgs::PolicyStatus::PHASE_DONE);
+    announce(policy, amytiss::PolicyStatus::PHASE_DONE);
   } catch (const amytiss::Cancelled&) {
     outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
     ROS_WARN("%s", outcome.message.c_str());
-    update_status([&](amytiss_msgs::PolicyStatus& status) {
+    update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = amytiss_msgs::PolicyStatus::PHASE_CANCELLED;
+      status.phase = amytiss::PolicyStatus::PHASE_CANCELLED;
       status.remaining_s = -1;
       status.message = outcome.message;
     });
   } catch (const std::exception& error) {
     outcome.message = "synthesis of '" + config.name + "' failed: " + error.what();
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
-    update_status([&](amytiss_msgs::PolicyStatus& status) {
+    update_status([&](amytiss::PolicyStatus& status) {
       status.synthesizing = false;
-      status.phase = amytiss_msgs::PolicyStatus::PHASE_ERROR;
+      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
       status.remaining_s = -1;
       status.message = outcome.message;
     });
@@ -258,7 +258,7 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
   return outcome;
 }
 
-void SynthesizerNode::execute_goal(const amytiss_msgs::SynthesizeGoalConstPtr& goal) {
+void SynthesizerNode::execute_goal(const amytiss::SynthesizeGoalConstPtr& goal) {
   cancel_startup_job_ = true;
   std::lock_guard<std::mutex> job_lock(job_mutex_);
   const auto read_config = [&]() {
@@ -271,7 +271,7 @@ void SynthesizerNode::execute_goal(const amytiss_msgs::SynthesizeGoalConstPtr& g
       read_config, goal->force,
       [this] { return action_server_.isPreemptRequested() || !ros::ok(); },
       [this](const amytiss::Progress& progress) { action_server_.publishFeedback(feedback_from_progress(progress)); });
-  amytiss_msgs::SynthesizeResult result;
+  amytiss::SynthesizeResult result;
   result.success = outcome.success;
   result.message = outcome.message;
   result.policy_file = outcome.success ? outcome.policy_file : "";

@@ -2,9 +2,9 @@
 // The synthesizer node's logic (the node's main() only constructs it and spins).
 //
 // Interface (relative to the public node handle, /amytiss in the launch files):
-//   action  synthesize (amytiss_msgs/Synthesize): re-read the private parameters (or the goal's YAML)
+//   action  synthesize (amytiss/Synthesize): re-read the private parameters (or the goal's YAML)
 //           and synthesize; cancel the goal to stop; feedback per time step.
-//   topic   status (amytiss_msgs/PolicyStatus, latched): progress, errors, and each new policy;
+//   topic   status (amytiss/PolicyStatus, latched): progress, errors, and each new policy;
 //           republished every ~heartbeat_period_s as a heartbeat.
 //   topic   /diagnostics (diagnostic_updater): synthesis state, device, the ready policy.
 // Private parameters: the configuration schema (docs/configuration.md), plus
@@ -20,8 +20,8 @@
 
 #include <actionlib/server/simple_action_server.h>
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <amytiss_msgs/PolicyStatus.h>
-#include <amytiss_msgs/SynthesizeAction.h>
+#include <amytiss/PolicyStatus.h>
+#include <amytiss/SynthesizeAction.h>
 #include <ros/ros.h>
 
 #include "amytiss/config.hpp"
@@ -58,19 +58,19 @@ class SynthesizerNode {
               const ProgressSink& on_progress);
   Outcome run_from_source(const std::function<amytiss::Config()>& read_config, bool force,
                           const CancelCheck& cancelled, const ProgressSink& on_progress);
-  void execute_goal(const amytiss_msgs::SynthesizeGoalConstPtr& goal);
+  void execute_goal(const amytiss::SynthesizeGoalConstPtr& goal);
   /// Edits the status under its lock, stamps it and publishes it.
-  void update_status(const std::function<void(amytiss_msgs::PolicyStatus&)>& edit);
+  void update_status(const std::function<void(amytiss::PolicyStatus&)>& edit);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& diagnostic);
 
   ros::NodeHandle public_handle_, private_handle_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer heartbeat_timer_;
-  actionlib::SimpleActionServer<amytiss_msgs::SynthesizeAction> action_server_;
+  actionlib::SimpleActionServer<amytiss::SynthesizeAction> action_server_;
   ros::Publisher status_publisher_;
   std::mutex job_mutex_;  // one synthesis at a time
   std::mutex status_mutex_;
-  amytiss_msgs::PolicyStatus status_;
+  amytiss::PolicyStatus status_;
   std::atomic<bool> cancel_startup_job_{false};
   std::thread startup_thread_;
 };

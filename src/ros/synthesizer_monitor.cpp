@@ -14,7 +14,7 @@ std::string utc_time_text(double seconds) {
   return text;
 }
 
-void SynthesizerMonitor::on_status(const amytiss_msgs::PolicyStatus& status, double now_s) {
+void SynthesizerMonitor::on_status(const amytiss::PolicyStatus& status, double now_s) {
   ever_heard_ = true;
   last_heard_s_ = now_s;
   last_status_ = status;

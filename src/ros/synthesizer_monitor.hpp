@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss/PolicyStatus.h>
 
 namespace amytiss_ros {
 
@@ -24,7 +24,7 @@ class SynthesizerMonitor {
   /// heartbeat comes every second).
   explicit SynthesizerMonitor(double timeout_s) : timeout_s_(timeout_s) {}
 
-  void on_status(const amytiss_msgs::PolicyStatus& status, double now_s);
+  void on_status(const amytiss::PolicyStatus& status, double now_s);
 
   /// True after a status arrived, while statuses keep coming within the timeout and some node
   /// publishes them (publishers: the status subscription's publisher count).
@@ -44,13 +44,13 @@ class SynthesizerMonitor {
   std::string serving_notice(const ServedPolicy& served, double now_s, std::size_t publishers) const;
 
   /// The last status received (default-constructed before any).
-  const amytiss_msgs::PolicyStatus& last_status() const { return last_status_; }
+  const amytiss::PolicyStatus& last_status() const { return last_status_; }
 
  private:
   double timeout_s_;
   bool ever_heard_ = false;
   double last_heard_s_ = 0;
-  amytiss_msgs::PolicyStatus last_status_;
+  amytiss::PolicyStatus last_status_;
 };
 
 /// "2026-11-26 13:05:01 UTC" for a wall-clock time in seconds since the epoch.

@@ -10,8 +10,8 @@
 #include <thread>
 #include <vector>
 
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/PolicyStatus.h>
 #include <ros/ros.h>
 #include <ros/topic.h>
 
@@ -27,7 +27,7 @@ struct ThreadResult {
 // One client thread on its own persistent connection.
 ThreadResult run_client(const amytiss::Policy& policy, std::size_t calls, unsigned seed) {
   ros::NodeHandle handle;
-  ros::ServiceClient client = handle.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", true);
+  ros::ServiceClient client = handle.serviceClient<amytiss::GetInput>("/amytiss/get_input", true);
   std::mt19937_64 random(seed);
   std::vector<std::uniform_real_distribution<double>> coordinates;
   for (std::size_t dim = 0; dim < policy.states.dims(); ++dim) {
@@ -40,7 +40,7 @@ ThreadResult run_client(const amytiss::Policy& policy, std::size_t calls, unsign
   std::uniform_int_distribution<unsigned> steps(0, policy.horizon - 1);
   ThreadResult result;
   result.latencies_us.reserve(calls);
-  amytiss_msgs::GetInput service;
+  amytiss::GetInput service;
   service.request.state.resize(policy.states.dims());
   for (std::size_t call = 0; call < calls; ++call) {
     for (std::size_t dim = 0; dim < coordinates.size(); ++dim) service.request.state[dim] = coordinates[dim](random);
@@ -51,7 +51,7 @@ ThreadResult run_client(const amytiss::Policy& policy, std::size_t calls, unsign
     result.latencies_us.push_back(std::chrono::duration<double, std::micro>(end - start).count());
     if (!called || !service.response.success) {
       ++result.failures;
-      if (!called) client = handle.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", true);
+      if (!called) client = handle.serviceClient<amytiss::GetInput>("/amytiss/get_input", true);
     }
   }
   return result;
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   const std::size_t threads = std::stoul(argv[1]), calls = std::stoul(argv[2]);
   const unsigned seed = argc > 3 ? unsigned(std::stoul(argv[3])) : 1u;
   ros::NodeHandle handle;
-  const auto status = ros::topic::waitForMessage<amytiss_msgs::PolicyStatus>("/amytiss/status", handle,
+  const auto status = ros::topic::waitForMessage<amytiss::PolicyStatus>("/amytiss/status", handle,
                                                                              ros::Duration(600.0));
   if (!status || !status->ready) {
     std::fprintf(stderr, "no ready policy on /amytiss/status\n");

@@ -1,14 +1,14 @@
 // Asks /amytiss/get_input once, as a robot's client would; exit status 0 on a successful answer.
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/SynthesizeAction.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/SynthesizeAction.h>
 #include <ros/ros.h>
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "amytiss_client_check");
   ros::NodeHandle handle;
-  amytiss_msgs::SynthesizeGoal goal;  // the action's types are there too
+  amytiss::SynthesizeGoal goal;  // the action's types are there too
   goal.force = false;
-  amytiss_msgs::GetInput service;
+  amytiss::GetInput service;
   service.request.state = {-4.0, -4.0};
   service.request.time_step = 0;
   if (!ros::service::call("/amytiss/get_input", service)) return 2;

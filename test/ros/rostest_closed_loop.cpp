@@ -6,7 +6,7 @@
 #include <string>
 #include <mutex>
 
-#include <amytiss_msgs/EpisodeSummary.h>
+#include <amytiss/EpisodeSummary.h>
 
 #include "rostest_support.hpp"
 
@@ -24,9 +24,9 @@ constexpr double kMinimumTurnDegrees = 45.0;
 TEST(ClosedLoop, SteeringCarReachesTheTargetConsistentWithV0) {
   ros::NodeHandle handle;
   std::mutex mutex;
-  amytiss_msgs::EpisodeSummary::ConstPtr summary;
-  ros::Subscriber subscriber = handle.subscribe<amytiss_msgs::EpisodeSummary>(
-      "/amytiss/episode_summary", 1, [&](const amytiss_msgs::EpisodeSummary::ConstPtr& message) {
+  amytiss::EpisodeSummary::ConstPtr summary;
+  ros::Subscriber subscriber = handle.subscribe<amytiss::EpisodeSummary>(
+      "/amytiss/episode_summary", 1, [&](const amytiss::EpisodeSummary::ConstPtr& message) {
         std::lock_guard<std::mutex> lock(mutex);
         summary = message;
       });

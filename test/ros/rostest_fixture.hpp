@@ -5,8 +5,8 @@
 #include <vector>
 
 #include <actionlib/client/simple_action_client.h>
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/SynthesizeAction.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/SynthesizeAction.h>
 
 #include "rostest_support.hpp"
 
@@ -31,23 +31,23 @@ class SynthesizerAndServerTest : public ::testing::Test {
     ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(kServiceWaitSeconds)));
     // One persistent connection: a new TCP connection per call would leave a socket in TIME_WAIT
     // per call, and loops of calls can exhaust the ephemeral ports of a busy machine.
-    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
+    client_ = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/true);
     ASSERT_TRUE(action_.waitForServer(ros::Duration(kServiceWaitSeconds)));
-    ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.ready && !s.synthesizing; },
+    ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready && !s.synthesizing; },
                                  kPolicyWaitSeconds))
         << status_.latest().message;
     ASSERT_TRUE(poll_until([&] { return call().success; }, kPolicyWaitSeconds));
   }
   /// GetInput (the call itself must succeed; the answer may say no). The default state lies in
   /// the tiny_reach_avoid grid.
-  amytiss_msgs::GetInput::Response call(const std::vector<double>& state = {-4.0, -4.0}, unsigned step = 0) {
-    amytiss_msgs::GetInput service;
+  amytiss::GetInput::Response call(const std::vector<double>& state = {-4.0, -4.0}, unsigned step = 0) {
+    amytiss::GetInput service;
     service.request.state = state;
     service.request.time_step = step;
     EXPECT_TRUE(client_.call(service));
     return service.response;
   }
-  amytiss_msgs::SynthesizeResult run_goal(const amytiss_msgs::SynthesizeGoal& goal) {
+  amytiss::SynthesizeResult run_goal(const amytiss::SynthesizeGoal& goal) {
     action_.sendGoal(goal);
     EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
     return *action_.getResult();
@@ -56,7 +56,7 @@ class SynthesizerAndServerTest : public ::testing::Test {
   ros::NodeHandle handle_;
   StatusWatcher status_{handle_};
   ros::ServiceClient client_;
-  actionlib::SimpleActionClient<amytiss_msgs::SynthesizeAction> action_{"/amytiss/synthesize", true};
+  actionlib::SimpleActionClient<amytiss::SynthesizeAction> action_{"/amytiss/synthesize", true};
 };
 
 }  // namespace amytiss_test

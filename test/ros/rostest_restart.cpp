@@ -37,20 +37,20 @@ int node_pid(const std::string& node) {
 using RestartTest = amytiss_test::SynthesizerAndServerTest;
 
 TEST_F(RestartTest, KilledSynthesizerIsReportedAndARestartedOneIsFollowedWithoutAGoal) {
-  const amytiss_msgs::PolicyStatus served = status_.latest();
+  const amytiss::PolicyStatus served = status_.latest();
   ASSERT_EQ(1u, served.generation) << "the scenario needs a synthesizer that announced one policy";
-  amytiss_msgs::SynthesizeGoal slow;
+  amytiss::SynthesizeGoal slow;
   slow.config_yaml = amytiss_test::kSlowConfig;
   slow.force = true;
   action_.sendGoal(slow);
-  ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.synthesizing && s.percent > 0; },
+  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.synthesizing && s.percent > 0; },
                                30.0));
   const int pid = node_pid(kSynthesizer);
   ASSERT_GT(pid, 0);
   ASSERT_EQ(0, ::kill(pid, SIGKILL));
 
   // Still the previous policy, now with a notice that the synthesizer is gone.
-  amytiss_msgs::GetInput::Response response;
+  amytiss::GetInput::Response response;
   ASSERT_TRUE(amytiss_test::poll_until(
       [&] {
         response = call();
@@ -73,9 +73,9 @@ TEST_F(RestartTest, KilledSynthesizerIsReportedAndARestartedOneIsFollowedWithout
   pid_t restarted = 0;
   ASSERT_EQ(0, posix_spawn(&restarted, argv[0], nullptr, nullptr, argv.data(), environ));
   const bool followed = status_.wait_for(
-      [&](const amytiss_msgs::PolicyStatus& s) { return s.ready && s.horizon == 6 && s.generation == 1; },
+      [&](const amytiss::PolicyStatus& s) { return s.ready && s.horizon == 6 && s.generation == 1; },
       amytiss_test::kPolicyWaitSeconds);
-  const amytiss_msgs::PolicyStatus restarted_status = status_.latest();
+  const amytiss::PolicyStatus restarted_status = status_.latest();
   EXPECT_TRUE(followed) << restarted_status.message;
   EXPECT_NE(served.config_hash, restarted_status.config_hash);
   EXPECT_TRUE(amytiss_test::poll_until(

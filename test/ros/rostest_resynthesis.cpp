@@ -3,8 +3,8 @@
 #include <thread>
 
 #include <actionlib/client/simple_action_client.h>
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/SynthesizeAction.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/SynthesizeAction.h>
 
 #include "amytiss/policy_file.hpp"
 #include "rostest_fixture.hpp"
@@ -14,11 +14,11 @@ namespace {
 const std::string kSynthesizer = "/amytiss/synthesizer";
 using amytiss_test::kActionWaitSeconds;
 using amytiss_test::kSlowConfig;
-using Client = actionlib::SimpleActionClient<amytiss_msgs::SynthesizeAction>;
+using Client = actionlib::SimpleActionClient<amytiss::SynthesizeAction>;
 using ResynthesisTest = amytiss_test::SynthesizerAndServerTest;
 
 TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
-  const amytiss_msgs::PolicyStatus before = status_.latest();
+  const amytiss::PolicyStatus before = status_.latest();
 
   // Requests keep being answered, successfully, during the whole re-synthesis and swap.
   std::atomic<bool> stop{false};
@@ -26,9 +26,9 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   std::string first_failure;  // written by the caller thread only, read after join()
   std::thread caller([&] {
     // One persistent connection for the whole loop (see rostest_fixture.hpp).
-    ros::ServiceClient client = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
+    ros::ServiceClient client = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/true);
     while (!stop) {
-      amytiss_msgs::GetInput service;
+      amytiss::GetInput service;
       service.request.state = {-4.0, -4.0};
       service.request.time_step = 0;
       const bool called = client.call(service);
@@ -46,12 +46,12 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   target_lb[0] = 2.0;
   target_lb[1] = 2.0;
   ros::param::set(kSynthesizer + "/spec/target/lb", target_lb);
-  const amytiss_msgs::SynthesizeResult changed = run_goal(amytiss_msgs::SynthesizeGoal());
+  const amytiss::SynthesizeResult changed = run_goal(amytiss::SynthesizeGoal());
   EXPECT_TRUE(changed.success) << changed.message;
   EXPECT_FALSE(changed.reused);
-  ASSERT_TRUE(status_.wait_for([&](const amytiss_msgs::PolicyStatus& s) { return s.generation > before.generation; },
+  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > before.generation; },
                                amytiss_test::kPolicyWaitSeconds));
-  const amytiss_msgs::PolicyStatus after = status_.latest();
+  const amytiss::PolicyStatus after = status_.latest();
   EXPECT_EQ(after.syntheses_run, before.syntheses_run + 1);
   EXPECT_NE(after.config_hash, before.config_hash);
   EXPECT_EQ(after.horizon, 9u);
@@ -65,7 +65,7 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   double probability = -1;
   const std::vector<double> state = {-3.0, -4.0};
   ASSERT_EQ(fresh.policy.lookup(state.data(), 2, 1, expected.data(), &probability), amytiss::LookupStatus::Ok);
-  const amytiss_msgs::GetInput::Response response = call(state, 1);
+  const amytiss::GetInput::Response response = call(state, 1);
   EXPECT_TRUE(response.success);
   EXPECT_EQ(response.input, expected);
   EXPECT_EQ(response.probability, probability);
@@ -76,31 +76,31 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   EXPECT_GT(answered.load(), 0);
 
   // Unchanged parameters: the file is reused, nothing is computed.
-  const amytiss_msgs::SynthesizeResult unchanged = run_goal(amytiss_msgs::SynthesizeGoal());
+  const amytiss::SynthesizeResult unchanged = run_goal(amytiss::SynthesizeGoal());
   EXPECT_TRUE(unchanged.success) << unchanged.message;
   EXPECT_TRUE(unchanged.reused);
   EXPECT_NE(unchanged.message.find("reusing"), std::string::npos) << unchanged.message;
-  ASSERT_TRUE(status_.wait_for([&](const amytiss_msgs::PolicyStatus& s) { return s.generation > after.generation; },
+  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > after.generation; },
                                amytiss_test::kPolicyWaitSeconds));
   EXPECT_EQ(status_.latest().syntheses_run, after.syntheses_run);
   EXPECT_EQ(status_.latest().phase, "reused");
 
   // force: computed again although the file is valid.
-  amytiss_msgs::SynthesizeGoal forced;
+  amytiss::SynthesizeGoal forced;
   forced.force = true;
-  const amytiss_msgs::SynthesizeResult recomputed = run_goal(forced);
+  const amytiss::SynthesizeResult recomputed = run_goal(forced);
   EXPECT_TRUE(recomputed.success);
   EXPECT_FALSE(recomputed.reused);
 }
 
 TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
-  const amytiss_msgs::PolicyStatus before = status_.latest();
+  const amytiss::PolicyStatus before = status_.latest();
   std::atomic<int> feedbacks{0};
-  amytiss_msgs::SynthesizeGoal goal;
+  amytiss::SynthesizeGoal goal;
   goal.config_yaml = kSlowConfig;
   goal.force = true;
   action_.sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                   [&](const amytiss_msgs::SynthesizeFeedbackConstPtr& feedback) {
+                   [&](const amytiss::SynthesizeFeedbackConstPtr& feedback) {
                      if (feedback->phase == "synthesis") ++feedbacks;
                    });
   ASSERT_TRUE(amytiss_test::poll_until([&] { return feedbacks > 0; }, kActionWaitSeconds));
@@ -108,8 +108,8 @@ TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
   ASSERT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
   EXPECT_EQ(action_.getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   EXPECT_FALSE(action_.getResult()->success);
-  ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
-  const amytiss_msgs::PolicyStatus after = status_.latest();
+  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
+  const amytiss::PolicyStatus after = status_.latest();
   EXPECT_TRUE(after.ready);
   EXPECT_EQ(after.generation, before.generation);
   EXPECT_EQ(after.config_hash, before.config_hash);
@@ -117,14 +117,14 @@ TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
 }
 
 TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
-  const amytiss_msgs::PolicyStatus before = status_.latest();
-  amytiss_msgs::SynthesizeGoal goal;
+  const amytiss::PolicyStatus before = status_.latest();
+  amytiss::SynthesizeGoal goal;
   goal.config_yaml = std::string(kSlowConfig) + "\n";
   goal.config_yaml.replace(goal.config_yaml.find("horizon: 40"), 11, "horizon: 0");
-  const amytiss_msgs::SynthesizeResult result = run_goal(goal);
+  const amytiss::SynthesizeResult result = run_goal(goal);
   EXPECT_FALSE(result.success);
   EXPECT_NE(result.message.find("horizon"), std::string::npos) << result.message;
-  ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
+  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
   EXPECT_NE(status_.latest().message.find("horizon"), std::string::npos);
   EXPECT_TRUE(status_.latest().ready);
   EXPECT_EQ(status_.latest().generation, before.generation);

@@ -26,13 +26,13 @@ std::string repeat(const std::string& piece, std::size_t times) {
 class RobustnessTest : public amytiss_test::SynthesizerAndServerTest {
  protected:
   // A goal that must be refused with each of `expected` in its result and on /amytiss/status.
-  void expect_refused(const amytiss_msgs::SynthesizeGoal& goal, const std::vector<std::string>& expected) {
-    const amytiss_msgs::SynthesizeResult result = run_goal(goal);
+  void expect_refused(const amytiss::SynthesizeGoal& goal, const std::vector<std::string>& expected) {
+    const amytiss::SynthesizeResult result = run_goal(goal);
     EXPECT_FALSE(result.success);
     for (const auto& part : expected)
       EXPECT_NE(std::string::npos, result.message.find(part)) << result.message.substr(0, 500);
     // The previous refusal's status may still be the latest: wait for this one's.
-    const auto says_all = [&](const amytiss_msgs::PolicyStatus& s) {
+    const auto says_all = [&](const amytiss::PolicyStatus& s) {
       return s.phase == "error" && std::all_of(expected.begin(), expected.end(), [&](const std::string& part) {
                return s.message.find(part) != std::string::npos;
              });
@@ -49,16 +49,16 @@ TEST_F(RobustnessTest, DeepAndLongExpressionsAreRefusedAndTheNodeStaysUp) {
   XmlRpc::XmlRpcValue deep = good_dynamics;
   deep[0] = repeat("(", 10000) + "x0" + repeat(")", 10000);
   ros::param::set(kSynthesizer + "/dynamics", deep);
-  expect_refused(amytiss_msgs::SynthesizeGoal(), {"dynamics[0]: column ", "nested deeper than the limit of 256"});
+  expect_refused(amytiss::SynthesizeGoal(), {"dynamics[0]: column ", "nested deeper than the limit of 256"});
   deep[0] = repeat("-", 60000) + "x0";
   ros::param::set(kSynthesizer + "/dynamics", deep);
-  expect_refused(amytiss_msgs::SynthesizeGoal(), {"nested deeper than the limit of 256"});
+  expect_refused(amytiss::SynthesizeGoal(), {"nested deeper than the limit of 256"});
   ros::param::set(kSynthesizer + "/dynamics", good_dynamics);
 
   // Through a goal: abs( nested 100,000 deep, ^1 repeated, a 10 MB flat sum.
   const std::string head = "name: hostile\nstates: {lb: [-1], ub: [1], eta: [0.5]}\ndynamics: [\"";
   const std::string tail = "\"]\nnoise: {covariance: [0.1]}\nspec: {type: safety, horizon: 2}\n";
-  amytiss_msgs::SynthesizeGoal goal;
+  amytiss::SynthesizeGoal goal;
   goal.config_yaml = head + repeat("abs(", 100000) + "x0" + repeat(")", 100000) + tail;
   expect_refused(goal, {"characters long, more than the limit of 65536"});
   goal.config_yaml = head + "x0" + repeat("^1", 30000) + tail;
@@ -67,13 +67,13 @@ TEST_F(RobustnessTest, DeepAndLongExpressionsAreRefusedAndTheNodeStaysUp) {
   expect_refused(goal, {"10485762 characters long"});
 
   // Alive: the unchanged configuration is reused.
-  const amytiss_msgs::SynthesizeResult result = run_goal(amytiss_msgs::SynthesizeGoal());
+  const amytiss::SynthesizeResult result = run_goal(amytiss::SynthesizeGoal());
   EXPECT_TRUE(result.success) << result.message;
   EXPECT_TRUE(result.reused);
 }
 
 TEST_F(RobustnessTest, AZeroedPolicyFileIsRefusedAndComputedAgain) {
-  const amytiss_msgs::PolicyStatus before = status_.latest();
+  const amytiss::PolicyStatus before = status_.latest();
   const std::string file = before.policy_file;
   const amytiss::LoadedPolicy loaded = amytiss::read_policy_file(file);
   std::string bytes;
@@ -99,7 +99,7 @@ TEST_F(RobustnessTest, AZeroedPolicyFileIsRefusedAndComputedAgain) {
   }
   EXPECT_THROW(amytiss::read_policy_file(file), amytiss::PolicyFileError);
 
-  const amytiss_msgs::SynthesizeResult result = run_goal(amytiss_msgs::SynthesizeGoal());
+  const amytiss::SynthesizeResult result = run_goal(amytiss::SynthesizeGoal());
   EXPECT_TRUE(result.success) << result.message;
   EXPECT_FALSE(result.reused) << "a corrupt file must not be reused";
   EXPECT_EQ(before.syntheses_run + 1, status_.latest().syntheses_run);
@@ -134,7 +134,7 @@ TEST_F(RobustnessTest, BothNodesPublishDiagnostics) {
       if (pair.key == key) return pair.value;
     return std::string("<missing>");
   };
-  const amytiss_msgs::PolicyStatus current = status_.latest();
+  const amytiss::PolicyStatus current = status_.latest();
   EXPECT_EQ(diagnostic_msgs::DiagnosticStatus::OK, server.level) << server.message;
   EXPECT_EQ("True", value(server, "policy loaded"));
   EXPECT_EQ(current.config_name, value(server, "policy name"));

@@ -4,9 +4,9 @@
 #include <limits>
 #include <random>
 
-#include <amytiss_msgs/GetInput.h>
-#include <amytiss_msgs/InputCommand.h>
-#include <amytiss_msgs/StateStamped.h>
+#include <amytiss/GetInput.h>
+#include <amytiss/InputCommand.h>
+#include <amytiss/StateStamped.h>
 
 #include "amytiss/policy_file.hpp"
 #include "rostest_support.hpp"
@@ -21,16 +21,16 @@ class ServiceTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(ros::service::waitForService("/amytiss/get_input", ros::Duration(amytiss_test::kServiceWaitSeconds)));
     // One persistent connection (see rostest_fixture.hpp).
-    client_ = handle_.serviceClient<amytiss_msgs::GetInput>("/amytiss/get_input", /*persistent=*/true);
-    ASSERT_TRUE(status_.wait_for([](const amytiss_msgs::PolicyStatus& s) { return s.ready; },
+    client_ = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/true);
+    ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready; },
                                  amytiss_test::kPolicyWaitSeconds))
         << "no ready policy; last status: " << status_.latest().message;
     loaded_ = amytiss::read_policy_file(status_.latest().policy_file);
     // The server loads the file after the status arrives: wait until it answers.
     ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
   }
-  amytiss_msgs::GetInput::Response call(const std::vector<double>& state, unsigned step) {
-    amytiss_msgs::GetInput service;
+  amytiss::GetInput::Response call(const std::vector<double>& state, unsigned step) {
+    amytiss::GetInput service;
     service.request.state = state;
     service.request.time_step = step;
     EXPECT_TRUE(client_.call(service)) << "the service call itself failed";
@@ -58,7 +58,7 @@ TEST_F(ServiceTest, AnswersEqualTheCorePolicyForSampledStates) {
     double expected_probability = -1;
     ASSERT_EQ(policy.lookup(state.data(), state.size(), step, expected_input.data(), &expected_probability),
               amytiss::LookupStatus::Ok);
-    const amytiss_msgs::GetInput::Response response = call(state, step);
+    const amytiss::GetInput::Response response = call(state, step);
     ASSERT_TRUE(response.success) << response.message;
     EXPECT_EQ(response.input, expected_input);
     EXPECT_EQ(response.probability, expected_probability);
@@ -78,7 +78,7 @@ TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStays
                {{40.0, 0.0}, 0, "outside"},    {{0.0, -5.26}, 0, "outside"},  {{0.0, 0.0}, horizon, "horizon"},
                {{0.0, 0.0}, 4000000000u, "horizon"}};
   for (const auto& c : cases) {
-    const amytiss_msgs::GetInput::Response response = call(c.state, c.step);
+    const amytiss::GetInput::Response response = call(c.state, c.step);
     EXPECT_FALSE(response.success);
     EXPECT_TRUE(response.input.empty());
     EXPECT_NE(response.message.find(c.expected_word), std::string::npos) << response.message;
@@ -90,18 +90,18 @@ TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStays
 TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {
   std::mutex mutex;
   std::condition_variable arrived;
-  std::vector<amytiss_msgs::InputCommand> commands;
-  ros::Subscriber subscriber = handle_.subscribe<amytiss_msgs::InputCommand>(
-      "/amytiss/command", 10, [&](const amytiss_msgs::InputCommand::ConstPtr& command) {
+  std::vector<amytiss::InputCommand> commands;
+  ros::Subscriber subscriber = handle_.subscribe<amytiss::InputCommand>(
+      "/amytiss/command", 10, [&](const amytiss::InputCommand::ConstPtr& command) {
         std::lock_guard<std::mutex> lock(mutex);
         commands.push_back(*command);
         arrived.notify_all();
       });
-  ros::Publisher publisher = handle_.advertise<amytiss_msgs::StateStamped>("/amytiss/state", 10);
+  ros::Publisher publisher = handle_.advertise<amytiss::StateStamped>("/amytiss/state", 10);
   ASSERT_TRUE(amytiss_test::poll_until(
       [&] { return publisher.getNumSubscribers() > 0 && subscriber.getNumPublishers() > 0; },
       amytiss_test::kServiceWaitSeconds));
-  amytiss_msgs::StateStamped good, bad;
+  amytiss::StateStamped good, bad;
   good.header.stamp = ros::Time(100, 1);
   good.state = {-4.0, -4.0};
   good.time_step = 2;

@@ -3,7 +3,7 @@
 #include <functional>
 #include <mutex>
 
-#include <amytiss_msgs/PolicyStatus.h>
+#include <amytiss/PolicyStatus.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -18,12 +18,12 @@ class StatusWatcher {
  public:
   explicit StatusWatcher(ros::NodeHandle& handle)
       : subscriber_(handle.subscribe("/amytiss/status", 20, &StatusWatcher::on_status, this)) {}
-  amytiss_msgs::PolicyStatus latest() {
+  amytiss::PolicyStatus latest() {
     std::lock_guard<std::mutex> lock(mutex_);
     return latest_;
   }
   /// Waits (bounded) until `condition` holds for the latest status; returns whether it did.
-  bool wait_for(const std::function<bool(const amytiss_msgs::PolicyStatus&)>& condition, double seconds) {
+  bool wait_for(const std::function<bool(const amytiss::PolicyStatus&)>& condition, double seconds) {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       if (condition(latest())) return true;
@@ -33,12 +33,12 @@ class StatusWatcher {
   }
 
  private:
-  void on_status(const amytiss_msgs::PolicyStatus::ConstPtr& status) {
+  void on_status(const amytiss::PolicyStatus::ConstPtr& status) {
     std::lock_guard<std::mutex> lock(mutex_);
     latest_ = *status;
   }
   std::mutex mutex_;
-  amytiss_msgs::PolicyStatus latest_;
+  amytiss::PolicyStatus latest_;
   ros::Subscriber subscriber_;
 };
 

@@ -134,7 +134,7 @@ class LookupConversions : public ::testing::Test {
 amytiss::Policy* LookupConversions::policy_ = nullptr;
 
 TEST_F(LookupConversions, ResponseEqualsThePolicyForEveryCellAndStep) {
-  amytiss_msgs::GetInput::Response response;
+  amytiss::GetInput::Response response;
   std::vector<double> expected_input(policy_->inputs.dims());
   for (unsigned step = 0; step < policy_->horizon; ++step) {
     for (std::size_t cell = 0; cell < policy_->states.size(); ++cell) {
@@ -162,7 +162,7 @@ TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
                {{0.0, -5.3}, 0, "outside"},    {{0.0, 0.0}, 14, "horizon"},       {{0.0, 0.0}, 1000, "horizon"},
                {{}, 0, "expected 2"}};
   for (const auto& c : cases) {
-    amytiss_msgs::GetInput::Response response;
+    amytiss::GetInput::Response response;
     response.input = {42.0};
     amytiss_ros::fill_get_input_response(policy_, c.state, c.step, "", response);
     EXPECT_FALSE(response.success);
@@ -182,7 +182,7 @@ TEST_F(LookupConversions, StationaryPolicyIgnoresTheStep) {
   ASSERT_TRUE(stationary.stationary);
   for (unsigned step : {0u, 1u, 57u, 4000000000u}) {
     for (std::size_t cell = 0; cell < stationary.states.size(); ++cell) {
-      amytiss_msgs::GetInput::Response response;
+      amytiss::GetInput::Response response;
       amytiss_ros::fill_get_input_response(&stationary, stationary.states.point(cell), step, "", response);
       ASSERT_TRUE(response.success) << response.message;
       ASSERT_EQ(response.probability, stationary.value(0, cell));
@@ -191,7 +191,7 @@ TEST_F(LookupConversions, StationaryPolicyIgnoresTheStep) {
 }
 
 TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
-  amytiss_msgs::GetInput::Response response;
+  amytiss::GetInput::Response response;
   amytiss_ros::fill_get_input_response(nullptr, {0.0, 0.0}, 0, "synthesis is running (42%)", response);
   EXPECT_FALSE(response.success);
   EXPECT_EQ(response.message, "no policy yet: synthesis is running (42%)");
@@ -203,16 +203,16 @@ TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
 TEST_F(LookupConversions, AnswersNameThePolicyAndCarryTheServerNotice) {
   const std::string notice = "synthesizer not running since 2025-11-26 13:05:00 UTC (no status for 15.2 s); "
                              "serving policy 'tiny'";
-  amytiss_msgs::GetInput::Response response;
+  amytiss::GetInput::Response response;
   amytiss_ros::fill_get_input_response(policy_, {0.0, 0.0}, 0, notice, response);
   EXPECT_TRUE(response.success);
   EXPECT_EQ(response.message, notice);
   EXPECT_EQ(response.config_hash, "0123456789abcdef");
   EXPECT_EQ(response.run_id, "fedcba9876543210");
 
-  amytiss_msgs::StateStamped state;
+  amytiss::StateStamped state;
   state.state = {0.0, 0.0};
-  amytiss_msgs::InputCommand command;
+  amytiss::InputCommand command;
   amytiss_ros::fill_input_command(policy_, state, notice, command);
   EXPECT_TRUE(command.valid);
   EXPECT_EQ(command.message, notice);
@@ -224,12 +224,12 @@ TEST_F(LookupConversions, AnswersNameThePolicyAndCarryTheServerNotice) {
 }
 
 TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerialization) {
-  amytiss_msgs::StateStamped state;
+  amytiss::StateStamped state;
   state.header.stamp = ros::Time(12, 345);
   state.header.frame_id = "map";
   state.state = {-4.0, -4.1};
   state.time_step = 3;
-  amytiss_msgs::InputCommand command;
+  amytiss::InputCommand command;
   amytiss_ros::fill_input_command(policy_, state, "", command);
   ASSERT_TRUE(command.valid) << command.message;
   EXPECT_EQ(command.header.stamp, state.header.stamp);
@@ -246,7 +246,7 @@ TEST_F(LookupConversions, CommandCopiesStampAndStepAndRoundTripsThroughSerializa
   std::vector<uint8_t> buffer(length);
   ros::serialization::OStream out(buffer.data(), length);
   ros::serialization::serialize(out, command);
-  amytiss_msgs::InputCommand decoded;
+  amytiss::InputCommand decoded;
   ros::serialization::IStream in(buffer.data(), length);
   ros::serialization::deserialize(in, decoded);
   EXPECT_EQ(decoded, command);
@@ -266,7 +266,7 @@ TEST(ProgressConversions, FeedbackCarriesEveryField) {
   progress.device = "reference";
   progress.elapsed_s = 1.5;
   progress.remaining_s = 2.0;
-  const amytiss_msgs::SynthesizeFeedback feedback = amytiss_ros::feedback_from_progress(progress);
+  const amytiss::SynthesizeFeedback feedback = amytiss_ros::feedback_from_progress(progress);
   EXPECT_EQ(feedback.phase, "synthesis");
   EXPECT_EQ(feedback.steps_done, 7u);
   EXPECT_EQ(feedback.steps_total, 16u);
@@ -389,15 +389,15 @@ int main(int argc, char** argv) {
 // The engine's phase names are the message constants, in PolicyStatus and in the action feedback.
 TEST(ProgressConversions, PhaseNamesAreTheMessageConstants) {
   const std::pair<amytiss::Phase, std::string> status_phases[] = {
-      {amytiss::Phase::Setup, amytiss_msgs::PolicyStatus::PHASE_SETUP},
-      {amytiss::Phase::Construction, amytiss_msgs::PolicyStatus::PHASE_CONSTRUCTION},
-      {amytiss::Phase::Synthesis, amytiss_msgs::PolicyStatus::PHASE_SYNTHESIS},
-      {amytiss::Phase::Done, amytiss_msgs::PolicyStatus::PHASE_DONE}};
+      {amytiss::Phase::Setup, amytiss::PolicyStatus::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss::PolicyStatus::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss::PolicyStatus::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss::PolicyStatus::PHASE_DONE}};
   for (const auto& [phase, name] : status_phases) EXPECT_EQ(amytiss::to_string(phase), name);
   const std::pair<amytiss::Phase, std::string> feedback_phases[] = {
-      {amytiss::Phase::Setup, amytiss_msgs::SynthesizeFeedback::PHASE_SETUP},
-      {amytiss::Phase::Construction, amytiss_msgs::SynthesizeFeedback::PHASE_CONSTRUCTION},
-      {amytiss::Phase::Synthesis, amytiss_msgs::SynthesizeFeedback::PHASE_SYNTHESIS},
-      {amytiss::Phase::Done, amytiss_msgs::SynthesizeFeedback::PHASE_DONE}};
+      {amytiss::Phase::Setup, amytiss::SynthesizeFeedback::PHASE_SETUP},
+      {amytiss::Phase::Construction, amytiss::SynthesizeFeedback::PHASE_CONSTRUCTION},
+      {amytiss::Phase::Synthesis, amytiss::SynthesizeFeedback::PHASE_SYNTHESIS},
+      {amytiss::Phase::Done, amytiss::SynthesizeFeedback::PHASE_DONE}};
   for (const auto& [phase, name] : feedback_phases) EXPECT_EQ(amytiss::to_string(phase), name);
 }

@@ -9,8 +9,8 @@ namespace {
 constexpr double kTimeout = 3.0;
 constexpr double kStart = 1764162300.0;  // 2025-11-26 13:05:00 UTC
 
-amytiss_msgs::PolicyStatus running_status() {
-  amytiss_msgs::PolicyStatus status;
+amytiss::PolicyStatus running_status() {
+  amytiss::PolicyStatus status;
   status.synthesizing = true;
   status.percent = 41;
   status.message = "synthesis 41% (step 5/12) on reference";
