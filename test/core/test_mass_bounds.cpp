@@ -1,6 +1,6 @@
 // Interval transition bounds per dimension (model/mass_bounds.hpp): the 1-d extrema of each law
 // against closed forms, soundness over sampled means and scales (every law, additive and
-// multiplicative), the union window and the residual's cut flag.
+// multiplicative), the union window and the mass leaving the grid or cut by the truncation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -234,29 +234,33 @@ TEST(MassBounds, WindowIsTheUnionOverTheMeans) {
   EXPECT_EQ(last, k_last);
 }
 
-TEST(MassBounds, ResidualIsCutOnlyWhereTheNoiseCanReachCellsOutsideTheWindow) {
+TEST(MassBounds, LeaveAndCutMassHoldWhatTheWindowMisses) {
   // Normal noise with a fixed region: the tails reach cells outside the window.
   OneDimension truncated(normal_noise({0.04}, Truncation::FixedRegion, 1e-3, {0.45}));
-  const DimensionBounds normal = truncated.bounds.dimension_bounds(truncated.grid, 0.0, 0.1, 0.2, 0.2);
-  EXPECT_TRUE(normal.cut);
-  EXPECT_GT(normal.residual.hi, 0.0);
-  // Uniform noise: the window covers the support, so the residual only leaves the grid.
+  const DimensionBounds normal = truncated.bounds.dimension_bounds(truncated.grid, 1.2, 1.4, 0.2, 0.2);
+  EXPECT_GT(normal.cut.hi, 0.0);
+  for (int i = 0; i <= 20; ++i) {
+    const double m = 1.2 + 0.2 * i / 20.0;
+    double on_grid = 0, in_window = 0;
+    for (std::size_t k = 0; k < truncated.grid.count(0); ++k) {
+      const double mass = truncated.noise.cell_mass(0, k, m, 0.2);
+      on_grid += mass;
+      if (std::int64_t(k) >= normal.first && std::int64_t(k) <= normal.last) in_window += mass;
+    }
+    EXPECT_LE(normal.leave.lo, 1.0 - on_grid);
+    EXPECT_GE(normal.leave.hi, 1.0 - on_grid);
+    EXPECT_LE(normal.cut.lo, on_grid - in_window);
+    EXPECT_GE(normal.cut.hi, on_grid - in_window);
+  }
+  // Uniform noise: the window covers the support, so nothing is cut, exactly.
   OneDimension uniform(uniform_noise({0.25}, Truncation::CuttingProbability));
   const DimensionBounds middle = uniform.bounds.dimension_bounds(uniform.grid, 0.0, 0.1, 0.25, 0.25);
-  EXPECT_FALSE(middle.cut);
-  EXPECT_EQ(middle.residual.lo, 0.0);
-  // Near the edge some mass leaves the grid: a residual, still not cut.
+  EXPECT_EQ(middle.cut.hi, 0.0);
+  EXPECT_EQ(middle.leave.lo, 0.0);
+  // Near the edge some mass leaves the grid; still nothing is cut.
   const DimensionBounds edge = uniform.bounds.dimension_bounds(uniform.grid, 1.9, 2.0, 0.25, 0.25);
-  EXPECT_FALSE(edge.cut);
-  EXPECT_GT(edge.residual.lo, 0.0);
-  // The residual holds the mass outside the window for every mean of the box.
-  for (int i = 0; i <= 20; ++i) {
-    const double m = 0.1 * i / 20.0;
-    double inside = 0;
-    for (std::int64_t k = normal.first; k <= normal.last; ++k) inside += truncated.noise.cell_mass(0, std::size_t(k), m, 0.2);
-    EXPECT_LE(normal.residual.lo, 1.0 - inside);
-    EXPECT_GE(normal.residual.hi, 1.0 - inside);
-  }
+  EXPECT_EQ(edge.cut.hi, 0.0);
+  EXPECT_GT(edge.leave.lo, 0.0);
 }
 
 TEST(MassBounds, OutwardRounding) {

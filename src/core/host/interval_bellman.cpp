@@ -50,10 +50,7 @@ IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& di
   require(dims > 0 && dimensions.size() == dims, "one DimensionBounds per state dimension");
   IntervalRow row;
   bool empty = false;
-  for (const DimensionBounds& dimension : dimensions) {
-    row.cut = row.cut || dimension.cut;
-    empty = empty || dimension.cells.empty();
-  }
+  for (const DimensionBounds& dimension : dimensions) empty = empty || dimension.cells.empty();
   std::vector<MassInterval> cells;
   if (!empty) {
     std::vector<std::size_t> multi(dims), offset(dims, 0);  // offset[d]: index into dimensions[d].cells
@@ -79,26 +76,35 @@ IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& di
       if (d == std::size_t(-1)) break;
     }
   }
-  // Outside the joint window means outside some dimension's: at least the largest of their
-  // residuals, at most their sum.
-  MassInterval residual = remainder(cells.data(), cells.size());
-  double union_hi = dimensions[0].residual.hi;
-  for (const DimensionBounds& dimension : dimensions) residual.lo = std::max(residual.lo, dimension.residual.lo);
-  for (std::size_t d = 1; d < dims; ++d) union_hi = round_up(union_hi + dimensions[d].residual.hi);
-  residual.hi = std::min(residual.hi, union_hi);
+  // Off the grid: off it along some dimension, so at least the largest and at most the sum of
+  // theirs. Cut (on the grid, outside the window): outside some dimension's window, at most the
+  // sum (in 1-d exactly the dimension's). Both at most what the cells leave.
+  const MassInterval rest = remainder(cells.data(), cells.size());
+  MassInterval leave = dimensions[0].leave, cut = dimensions[0].cut;
+  if (dims > 1) cut.lo = 0.0;
+  for (std::size_t d = 1; d < dims; ++d) {
+    leave.lo = std::max(leave.lo, dimensions[d].leave.lo);
+    leave.hi = round_up(leave.hi + dimensions[d].leave.hi);
+    cut.hi = round_up(cut.hi + dimensions[d].cut.hi);
+  }
+  leave.hi = std::min(leave.hi, rest.hi);
+  cut.hi = std::min(cut.hi, rest.hi);
   for (const MassInterval& mass : cells) {
     row.lo.push_back(mass.lo);
     row.hi.push_back(mass.hi);
   }
-  row.lo.push_back(residual.lo);
-  row.hi.push_back(residual.hi);
+  for (const MassInterval& mass : {leave, cut}) {
+    row.lo.push_back(mass.lo);
+    row.hi.push_back(mass.hi);
+  }
   return row;
 }
 
 double joint_expectation(const IntervalRow& row, const double* values, Bound bound) {
   std::vector<double> outcome_values(row.lo.size());
   for (std::size_t j = 0; j < row.targets.size(); ++j) outcome_values[j] = values[row.targets[j]];
-  outcome_values.back() = residual_value(bound, row.cut);
+  outcome_values[row.targets.size()] = 0.0;  // leaves the grid
+  outcome_values[row.targets.size() + 1] = cut_value(bound);
   std::vector<std::size_t> order;
   return robust_expectation(row.lo.data(), row.hi.data(), outcome_values.data(), row.lo.size(), bound, order);
 }
@@ -118,7 +124,7 @@ struct ProductStages {
   double eliminate(std::size_t d, std::size_t offset) {
     const DimensionBounds& dimension = dimensions[d];
     const std::size_t cells = dimension.cells.size();
-    std::vector<double> lo(cells + 1), hi(cells + 1), line(cells + 1, 0.0);
+    std::vector<double> lo(cells + 2), hi(cells + 2), line(cells + 2, 0.0);
     for (std::size_t j = 0; j < cells; ++j) {
       lo[j] = dimension.cells[j].lo;
       hi[j] = dimension.cells[j].hi;
@@ -126,10 +132,12 @@ struct ProductStages {
       // An outcome that can get no mass needs no value.
       if (hi[j] > 0.0) line[j] = d + 1 == dimensions.size() ? values[position] : eliminate(d + 1, position);
     }
-    lo[cells] = dimension.residual.lo;
-    hi[cells] = dimension.residual.hi;
-    line[cells] = residual_value(bound, dimension.cut);
-    return robust_expectation(lo.data(), hi.data(), line.data(), cells + 1, bound, order);
+    lo[cells] = dimension.leave.lo;  // worth 0
+    hi[cells] = dimension.leave.hi;
+    lo[cells + 1] = dimension.cut.lo;
+    hi[cells + 1] = dimension.cut.hi;
+    line[cells + 1] = cut_value(bound);
+    return robust_expectation(lo.data(), hi.data(), line.data(), cells + 2, bound, order);
   }
 };
 

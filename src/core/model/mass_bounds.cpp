@@ -259,30 +259,38 @@ DimensionBounds MassBounds::dimension_bounds(const Grid& states, double m_lo, do
   const auto count = static_cast<std::int64_t>(states.count(dim_));
   // Cell faces as the noise model computes them: lb + (k -+ 1/2) eta.
   auto face = [&](std::int64_t k) { return lb + (double(k) - 0.5) * eta; };
+  auto mass = [&](double a, double b) { return bounds(a, b, m_lo, m_hi, s_lo, s_hi); };
+  auto sum = [](const MassInterval& x, const MassInterval& y) {
+    return MassInterval{std::max(0.0, round_down(x.lo + y.lo)), std::min(1.0, round_up(x.hi + y.hi))};
+  };
   const bool inside = window(states, m_lo, m_hi, &out.first, &out.last);
   if (inside) {
     out.cells.reserve(std::size_t(out.last - out.first + 1));
-    for (std::int64_t k = out.first; k <= out.last; ++k) out.cells.push_back(bounds(face(k), face(k + 1), m_lo, m_hi, s_lo, s_hi));
+    for (std::int64_t k = out.first; k <= out.last; ++k) out.cells.push_back(mass(face(k), face(k + 1)));
   } else {
     out.first = 0;
     out.last = -1;
   }
-  out.residual = remainder(out.cells.data(), out.cells.size());
-  if (inside) {
-    // The two half-lines beyond the window, bounded directly: far tighter than the remainder
-    // when the cells' intervals are wide.
-    const MassInterval left = bounds(-kInfinity, face(out.first), m_lo, m_hi, s_lo, s_hi);
-    const MassInterval right = bounds(face(out.last + 1), kInfinity, m_lo, m_hi, s_lo, s_hi);
-    out.residual.lo = std::max(out.residual.lo, round_down(left.lo + right.lo));
-    out.residual.hi = std::min(out.residual.hi, round_up(left.hi + right.hi));
-  }
-  // Where the noise can put mass: m + s Z over the means, the scales and Z's support.
+  // Beyond the grid's faces; on the grid outside the window (both sides, or all of it).
+  out.leave = sum(mass(-kInfinity, face(0)), mass(face(count), kInfinity));
+  MassInterval cut{0.0, 0.0};
+  if (!inside) cut = mass(face(0), face(count));
+  if (inside && out.first > 0) cut = sum(cut, mass(face(0), face(out.first)));
+  if (inside && out.last < count - 1) cut = sum(cut, mass(face(out.last + 1), face(count)));
+  // Where the noise can put mass: m + s Z over the means, the scales and Z's support. A cut it
+  // cannot reach is exactly 0 (the bounds above carry the evaluation error).
   auto extent = [&](double z, double s) { return std::isinf(z) ? (s > 0 ? z : 0.0) : s * z; };
   const double reach_lo = round_down(m_lo + std::min(extent(support_lo_, s_lo), extent(support_lo_, s_hi)), 2);
   const double reach_hi = round_up(m_hi + std::max(extent(support_hi_, s_lo), extent(support_hi_, s_hi)), 2);
   auto meets = [&](double lo, double hi) { return lo <= hi && reach_lo <= hi && reach_hi >= lo; };
-  if (!inside) out.cut = meets(face(0), face(count));
-  else out.cut = (out.first > 0 && meets(face(0), face(out.first))) || (out.last < count - 1 && meets(face(out.last + 1), face(count)));
+  const bool reachable = inside ? (out.first > 0 && meets(face(0), face(out.first))) ||
+                                      (out.last < count - 1 && meets(face(out.last + 1), face(count)))
+                                : meets(face(0), face(count));
+  out.cut = reachable ? cut : MassInterval{0.0, 0.0};
+  // Together they hold what the cells leave.
+  const MassInterval rest = remainder(out.cells.data(), out.cells.size());
+  out.leave.hi = std::min(out.leave.hi, rest.hi);
+  out.cut.hi = std::min(out.cut.hi, rest.hi);
   return out;
 }
 

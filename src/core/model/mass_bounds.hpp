@@ -34,16 +34,13 @@ struct MassInterval {
   double hi = 0;
 };
 
-/// The bounds of one row (source cell, input, disturbance) along one dimension.
+/// The bounds of one row (source cell, input, disturbance) along one dimension: the window's cells
+/// and the two other outcomes, which with them make up all the mass.
 struct DimensionBounds {
   std::int64_t first = 0, last = -1;  ///< window cells (grid indices); empty when last < first
   std::vector<MassInterval> cells;    ///< cells[k - first]: the mass of cell k
-  /// The mass outside the window (off the grid or cut): remainder() of the cells, narrowed by the
-  /// direct bounds of the two half-lines beyond the window.
-  MassInterval residual{1, 1};
-  /// Some of the residual may land on grid cells outside the window (cut by the truncation); when
-  /// false, all of it leaves the grid.
-  bool cut = false;
+  MassInterval leave;                 ///< the mass beyond the grid's faces (leaves the grid)
+  MassInterval cut;                   ///< the mass on grid cells outside the window (cut by the truncation)
 };
 
 /// Unit roundoff of double precision: a correctly rounded operation errs by at most this, relative.
@@ -91,8 +88,9 @@ class MassBounds {
   /// The union over post means in [m_lo, m_hi] of the truncation window (NoiseModel::dimension_window):
   /// grid cells first..last. False when it misses the grid (every mean's kept mass leaves it).
   bool window(const Grid& states, double m_lo, double m_hi, std::int64_t* first, std::int64_t* last) const;
-  /// Bounds of every window cell, the residual and whether it may be cut, for means in
-  /// [m_lo, m_hi] and scales in [s_lo, s_hi].
+  /// Bounds of every window cell, of the mass leaving the grid and of the mass cut (exactly 0 where
+  /// m + s Z cannot reach grid cells outside the window), for means in [m_lo, m_hi] and scales in
+  /// [s_lo, s_hi]; leave and cut no more than remainder() of the cells.
   DimensionBounds dimension_bounds(const Grid& states, double m_lo, double m_hi, double s_lo, double s_hi) const;
 
  private:
