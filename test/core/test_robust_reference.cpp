@@ -25,22 +25,26 @@ constexpr double kOrthogonalSlack = 1e-12;
 constexpr double kInformativeGap = 0.75;
 constexpr double kInformativeLower = 0.5;
 
-// post = slope * x + drift (1-d), the mean box of a cell from its faces, rounded outward.
+// post = slope * x + drift + u (1-d; u = 0 without inputs), the mean box of a cell from its
+// faces, rounded outward.
 struct LinearSystem {
   double slope, drift, sigma;
-  void box(double x_lo, double x_hi, double* lo, double* hi) const {
-    const double p = slope * x_lo + drift, q = slope * x_hi + drift;
-    *lo = round_down(std::min(p, q), 2);
-    *hi = round_up(std::max(p, q), 2);
+  std::vector<double> inputs;  ///< the input grid's points (empty: autonomous)
+  double input(std::size_t index) const { return inputs.empty() ? 0.0 : inputs[index]; }
+  void box(double x_lo, double x_hi, std::size_t u, double* lo, double* hi) const {
+    const double p = slope * x_lo + drift + input(u), q = slope * x_hi + drift + input(u);
+    *lo = round_down(std::min(p, q), 3);
+    *hi = round_up(std::max(p, q), 3);
   }
 };
 
-// The continuous value V_0 at the Simpson nodes of each cell (value[cell][j] at x = face + j h):
+// The continuous value V_0 at the Simpson nodes of each cell (value[cell][j] at x = face + j h)
+// under the cell-based controller (controller[k * cells + cell]; empty: input 0):
 // V_T = terminal on Free points, 1 on the target, 0 on the avoid set and off the grid [-1, 1];
-// V_k(x) = integral over the grid of N(y; slope x + drift, sigma^2) V_{k+1}(y) dy on Free points.
+// V_k(x) = integral over the grid of N(y; slope x + drift + u, sigma^2) V_{k+1}(y) dy on Free points.
 std::vector<std::vector<double>> continuous_value(const Grid& grid, const LinearSystem& system,
                                                   const std::vector<CellRole>& roles, double terminal,
-                                                  unsigned horizon) {
+                                                  unsigned horizon, const std::vector<std::uint32_t>& controller) {
   const std::size_t cells = grid.size();
   const double eta = grid.eta()[0], h = eta / kIntervalsPerCell;
   auto node = [&](std::size_t cell, int j) { return grid.coordinate(0, cell) - 0.5 * eta + j * h; };
@@ -48,12 +52,13 @@ std::vector<std::vector<double>> continuous_value(const Grid& grid, const Linear
   std::vector<std::vector<double>> value(cells, std::vector<double>(kIntervalsPerCell + 1));
   for (std::size_t c = 0; c < cells; ++c)
     for (double& v : value[c]) v = roles[c] == CellRole::Free ? terminal : fixed(c);
-  for (unsigned k = 0; k < horizon; ++k) {
+  for (unsigned k = horizon; k-- > 0;) {
     std::vector<std::vector<double>> next = value;
     for (std::size_t c = 0; c < cells; ++c) {
       if (roles[c] != CellRole::Free) continue;
+      const double u = system.input(controller.empty() ? 0 : controller[std::size_t(k) * cells + c]);
       for (int i = 0; i <= kIntervalsPerCell; ++i) {
-        const double mean = system.slope * node(c, i) + system.drift;
+        const double mean = system.slope * node(c, i) + system.drift + u;
         double integral = 0;
         // Each cell integrated on its own (the value may jump at the faces of fixed cells).
         for (std::size_t t = 0; t < cells; ++t) {
@@ -74,11 +79,15 @@ std::vector<std::vector<double>> continuous_value(const Grid& grid, const Linear
 RobustValues robust_1d(const Grid& grid, const LinearSystem& system, const SpecConfig& spec, AmbiguitySet set,
                        const NoiseModel& noise) {
   const Grid none;
-  RobustProblem problem{grid, none, none, noise, nullptr, spec.type, spec.horizon,
+  const Grid inputs = system.inputs.empty()
+                          ? Grid()
+                          : Grid(grid_spec({system.inputs.front()}, {system.inputs.back()},
+                                           {system.inputs[1] - system.inputs[0]}));
+  RobustProblem problem{grid, inputs, none, noise, nullptr, spec.type, spec.horizon,
                         robust_cell_roles(grid, spec, Bound::Lower), robust_cell_roles(grid, spec, Bound::Upper)};
-  problem.mean_box = [&](std::size_t cell, std::size_t, std::size_t, double* lo, double* hi) {
+  problem.mean_box = [&](std::size_t cell, std::size_t u, std::size_t, double* lo, double* hi) {
     const double centre = grid.coordinate(0, cell), half = 0.5 * grid.eta()[0];
-    system.box(centre - half, centre + half, lo, hi);
+    system.box(centre - half, centre + half, u, lo, hi);
   };
   return robust_values(problem, set);
 }
@@ -96,7 +105,7 @@ void expect_brackets_continuous_value(const SpecConfig& spec, const LinearSystem
   ASSERT_EQ(roles, robust_cell_roles(grid, spec, Bound::Lower));
   ASSERT_EQ(roles, robust_cell_roles(grid, spec, Bound::Upper));
   const double terminal = spec.type == SpecType::Safety ? 1.0 : 0.0;
-  const auto value = continuous_value(grid, system, roles, terminal, spec.horizon);
+  const auto value = continuous_value(grid, system, roles, terminal, spec.horizon, bounds.controller);
   double widest = 0, best_lower = 0;
   for (std::size_t c = 0; c < grid.size(); ++c) {
     for (double v : value[c]) {
@@ -118,6 +127,23 @@ TEST(RobustReference, SafetyBracketsTheContinuousValue) {
 TEST(RobustReference, ReachAvoidBracketsTheContinuousValue) {
   expect_brackets_continuous_value(reach_avoid_spec(6, box({0.4}, {0.8}), box({-0.5}, {-0.3})),
                                    LinearSystem{0.9, 0.12, 0.1});
+}
+
+TEST(RobustReference, ControllerOfTheLowerBoundBracketsItsContinuousValue) {
+  // The lower bound holds for the stored controller's continuous value, and the upper bound
+  // for any controller's (here the same one).
+  expect_brackets_continuous_value(reach_avoid_spec(5, box({0.4}, {0.8}), box({-0.5}, {-0.3})),
+                                   LinearSystem{0.9, 0.0, 0.1, {-0.1, 0.0, 0.1}});
+}
+
+TEST(RobustReference, ControllerMaximisesTheLowerBound) {
+  const Grid grid(grid_spec({-0.95}, {0.95}, {0.1}));
+  const LinearSystem system{1.0, 0.0, 0.05, {-0.1, 0.0, 0.1}};
+  const NoiseModel noise(normal_noise({system.sigma * system.sigma}), grid);
+  const RobustValues bounds = robust_1d(grid, system, reach_avoid_spec(3, box({-0.2}, {0.2})), AmbiguitySet::Joint, noise);
+  // Next to the target on either side the best input steps towards it.
+  EXPECT_EQ(bounds.controller[grid.nearest(0, -0.25)], 2u);
+  EXPECT_EQ(bounds.controller[grid.nearest(0, 0.25)], 0u);
 }
 
 TEST(RobustReference, TruncatedWindowsStillBracketTheContinuousValue) {

@@ -17,6 +17,8 @@
 //     that puts a on the law's shift; other beta laws: found by bisection on the sign of
 //     g' = (f((a - m)/s) - f((b - m)/s))/s, the CDF bound closing the last bracket), else at the
 //     endpoint nearer to the peak.
+// a or b may be infinite (a half-line: g is monotone in m and s, the CDF bound at the corners
+// is exact); a scale of 0 is a point mass.
 // Rounding: standardized bounds rounded outward (kRoundingUlps ulps), each mass widened by the
 // law's evaluation error (mass_error()), lo rounded down, hi rounded up, both clipped to [0, 1].
 #include <cstddef>
