@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "amytiss/errors.hpp"
@@ -261,6 +262,16 @@ TEST(MassBounds, LeaveAndCutMassHoldWhatTheWindowMisses) {
   const DimensionBounds edge = uniform.bounds.dimension_bounds(uniform.grid, 1.9, 2.0, 0.25, 0.25);
   EXPECT_EQ(edge.cut.hi, 0.0);
   EXPECT_GT(edge.leave.lo, 0.0);
+}
+
+TEST(MassBounds, UnboundedBoxOfMeansSaysNothing) {
+  OneDimension d(normal_noise({0.04}));
+  const DimensionBounds row = d.bounds.dimension_bounds(d.grid, -std::numeric_limits<double>::infinity(), 0.0, 0.2, 0.2);
+  EXPECT_TRUE(row.cells.empty());
+  EXPECT_EQ(row.leave.lo, 0.0);
+  EXPECT_EQ(row.leave.hi, 1.0);
+  EXPECT_EQ(row.cut.lo, 0.0);
+  EXPECT_EQ(row.cut.hi, 1.0);
 }
 
 TEST(MassBounds, OutwardRounding) {

@@ -255,6 +255,12 @@ bool MassBounds::window(const Grid& states, double m_lo, double m_hi, std::int64
 DimensionBounds MassBounds::dimension_bounds(const Grid& states, double m_lo, double m_hi, double s_lo,
                                              double s_hi) const {
   DimensionBounds out;
+  if (!std::isfinite(m_lo) || !std::isfinite(m_hi)) {
+    // An enclosure that blew up says nothing: the mass may go anywhere.
+    out.leave = {0.0, 1.0};
+    out.cut = {0.0, 1.0};
+    return out;
+  }
   const double lb = states.lb()[dim_], eta = states.eta()[dim_];
   const auto count = static_cast<std::int64_t>(states.count(dim_));
   // Cell faces as the noise model computes them: lb + (k -+ 1/2) eta.

@@ -92,7 +92,8 @@ class MassBounds {
   bool window(const Grid& states, double m_lo, double m_hi, std::int64_t* first, std::int64_t* last) const;
   /// Bounds of every window cell, of the mass leaving the grid and of the mass cut (exactly 0 where
   /// m + s Z cannot reach grid cells outside the window), for means in [m_lo, m_hi] and scales in
-  /// [s_lo, s_hi]; leave and cut no more than remainder() of the cells.
+  /// [s_lo, s_hi]; leave and cut no more than remainder() of the cells. A box that is not finite
+  /// gives no cells and leave and cut in [0, 1].
   DimensionBounds dimension_bounds(const Grid& states, double m_lo, double m_hi, double s_lo, double s_hi) const;
 
  private:
