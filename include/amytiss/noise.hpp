@@ -89,6 +89,10 @@ class NoiseModel {
   /// middle cell. 0 except for additive exponential/beta/custom noise with an asymmetric kept interval.
   const std::vector<double>& window_offset() const { return window_offset_; }
 
+  /// The law of Z_dim for exponential, beta and custom noise (noise = scale * Z, model/noise_laws.hpp);
+  /// nullptr for normal and uniform noise.
+  const detail::UnitLaw* unit_law(std::size_t dim) const { return laws_.empty() ? nullptr : laws_[dim].get(); }
+
   /// Mass of [lo, hi] under the 1-d law of dimension dim with the given mean and scale (a scale of
   /// 0 is a point mass: 1 when lo <= mean < hi). Exact (erfc), double precision.
   double interval_mass(std::size_t dim, double lo, double hi, double mean, double scale) const;
