@@ -44,6 +44,8 @@ struct Interval {
   bool contains(double value) const { return lo <= value && value <= hi; }
   bool contains_zero() const { return lo <= 0.0 && 0.0 <= hi; }
   double width() const { return is_empty() ? 0.0 : hi - lo; }
+  /// The largest absolute value (of a Jacobian entry: a Lipschitz constant).
+  double magnitude() const { return is_empty() ? 0.0 : (-lo > hi ? -lo : hi); }
   double mid() const;  ///< a double inside the interval (0 for the entire line)
 };
 
