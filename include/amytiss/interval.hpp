@@ -5,11 +5,13 @@
 // C++ evaluation of the same operation returns at those points.
 //
 // Rounding: each bound is computed in the default round-to-nearest mode and then moved outward with
-// std::nextafter: one step for + - * / and sqrt (correctly rounded, so within half a step), two
-// steps for the libm functions (sin, exp, pow, ...; glibc documents errors of at most one or two
-// units in the last place for them in double precision). The rounding mode is never changed:
-// fesetround is global to the thread, is ignored by libm and by compilers without
-// -frounding-math, and would disturb the engines' arithmetic running beside it.
+// std::nextafter: one step for + - * / and sqrt (correctly rounded, so within half a step), four
+// steps for the libm functions (sin, exp, pow, ...: not correctly rounded; glibc's measured
+// maxima on x86-64 are one or two units in the last place in double precision, a bound from its
+// tests, not a proof: soundness rests on it, and a libm with larger errors needs a larger
+// kLibmRoundingSteps). The rounding mode is never changed: fesetround is global to the thread, is
+// ignored by libm and by compilers without -frounding-math, and would disturb the engines'
+// arithmetic running beside it.
 //
 // Domains: an operation whose operand leaves its domain (log or sqrt of negatives, asin of values
 // beyond 1, a negative base with a non-integer exponent, 0/0) encloses its values over the part of
@@ -52,9 +54,17 @@ struct Interval {
 /// A box: one interval per component.
 using IntervalBox = std::vector<Interval>;
 
+/// Outward steps after a libm function (not correctly rounded) and after + - * / sqrt (correctly
+/// rounded).
+constexpr int kLibmRoundingSteps = 4;
+constexpr int kExactRoundingSteps = 1;
+
 /// The next double below / above `value`, `steps` times (infinities stay infinite outward).
 double round_down(double value, int steps = 1);
 double round_up(double value, int steps = 1);
+/// [lo, hi] computed in round-to-nearest, moved `steps` outward; a NaN bound (infinity minus
+/// infinity) becomes infinite.
+Interval rounded_outward(double lo, double hi, int steps, bool defined = true);
 
 Interval hull(const Interval& a, const Interval& b);       ///< smallest interval holding both
 Interval intersect(const Interval& a, const Interval& b);  ///< empty when disjoint
@@ -65,6 +75,8 @@ Interval operator-(const Interval& a, const Interval& b);
 Interval operator*(const Interval& a, const Interval& b);  ///< 0 * infinity counts as 0
 Interval operator/(const Interval& a, const Interval& b);
 
+/// Whether y is a single integer that integer_power() takes exactly (|y| <= 2^53).
+bool is_integer_exponent(const Interval& y);
 /// x^n for an integer n (exact integer exponent: the sign pattern of even and odd powers).
 Interval integer_power(const Interval& x, long n);
 /// pow(x, y) as std::pow: integer y handled by integer_power(), else x restricted to x >= 0.

@@ -8,18 +8,7 @@ namespace amytiss {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-// libm functions are not correctly rounded; two steps cover their documented error.
-constexpr int kLibmSteps = 2;
-
 bool both_defined(const Interval& a, const Interval& b) { return a.defined && b.defined; }
-
-// Bounds computed in round-to-nearest, moved outward. A NaN bound comes from infinity minus
-// infinity (or 0 * infinity in a libm call): the bound is then unknown, so it becomes infinite.
-Interval outward(double lo, double hi, bool defined, int steps = 1) {
-  lo = std::isnan(lo) ? -kInfinity : round_down(lo, steps);
-  hi = std::isnan(hi) ? kInfinity : round_up(hi, steps);
-  return {lo, hi, defined};
-}
 
 // The product as interval arithmetic needs it: 0 times anything (an infinite bound) is 0.
 double bound_product(double a, double b) { return a == 0.0 || b == 0.0 ? 0.0 : a * b; }
@@ -28,7 +17,7 @@ Interval from_values(const double* values, int count, bool defined, int steps) {
   for (int i = 0; i < count; ++i)
     if (std::isnan(values[i])) return Interval(-kInfinity, kInfinity, defined);
   const auto range = std::minmax_element(values, values + count);
-  return outward(*range.first, *range.second, defined, steps);
+  return rounded_outward(*range.first, *range.second, steps, defined);
 }
 
 const Interval kFalse = Interval::point(0.0);
@@ -47,6 +36,11 @@ double Interval::mid() const {
   if (lo == -kInfinity) return hi > 0.0 ? 0.0 : hi;
   if (hi == kInfinity) return lo < 0.0 ? 0.0 : lo;
   return std::clamp(0.5 * lo + 0.5 * hi, lo, hi);
+}
+
+Interval rounded_outward(double lo, double hi, int steps, bool defined) {
+  return {std::isnan(lo) ? -kInfinity : round_down(lo, steps), std::isnan(hi) ? kInfinity : round_up(hi, steps),
+          defined};
 }
 
 double round_down(double value, int steps) {
@@ -74,19 +68,19 @@ Interval operator-(const Interval& a) { return {-a.hi, -a.lo, a.defined}; }
 
 Interval operator+(const Interval& a, const Interval& b) {
   if (a.is_empty() || b.is_empty()) return Interval::empty(both_defined(a, b));
-  return outward(a.lo + b.lo, a.hi + b.hi, both_defined(a, b));
+  return rounded_outward(a.lo + b.lo, a.hi + b.hi, kExactRoundingSteps, both_defined(a, b));
 }
 
 Interval operator-(const Interval& a, const Interval& b) {
   if (a.is_empty() || b.is_empty()) return Interval::empty(both_defined(a, b));
-  return outward(a.lo - b.hi, a.hi - b.lo, both_defined(a, b));
+  return rounded_outward(a.lo - b.hi, a.hi - b.lo, kExactRoundingSteps, both_defined(a, b));
 }
 
 Interval operator*(const Interval& a, const Interval& b) {
   if (a.is_empty() || b.is_empty()) return Interval::empty(both_defined(a, b));
   const double products[] = {bound_product(a.lo, b.lo), bound_product(a.lo, b.hi), bound_product(a.hi, b.lo),
                              bound_product(a.hi, b.hi)};
-  return from_values(products, 4, both_defined(a, b), 1);
+  return from_values(products, 4, both_defined(a, b), kExactRoundingSteps);
 }
 
 // A divisor that contains 0 (even as an end point, where a signed zero decides between +inf and
@@ -95,7 +89,12 @@ Interval operator/(const Interval& a, const Interval& b) {
   if (a.is_empty() || b.is_empty()) return Interval::empty(both_defined(a, b));
   if (b.contains_zero()) return Interval(-kInfinity, kInfinity, both_defined(a, b) && !a.contains_zero());
   const double quotients[] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
-  return from_values(quotients, 4, both_defined(a, b), 1);
+  return from_values(quotients, 4, both_defined(a, b), kExactRoundingSteps);
+}
+
+bool is_integer_exponent(const Interval& y) {
+  constexpr double kExactInteger = 9007199254740992.0;  // 2^53: every double integer up to it converts exactly
+  return y.is_point() && std::floor(y.lo) == y.lo && std::fabs(y.lo) <= kExactInteger;
 }
 
 Interval integer_power(const Interval& x, long n) {
@@ -106,12 +105,12 @@ Interval integer_power(const Interval& x, long n) {
   const bool even = n % 2 == 0;
   if (x.contains_zero() && x.lo < x.hi) {
     if (n < 0 && !even) return Interval(-kInfinity, kInfinity, x.defined);
-    if (n < 0) return outward(std::min(power_lo, power_hi), kInfinity, x.defined, kLibmSteps);
-    if (even) return outward(0.0, std::max(power_lo, power_hi), x.defined, kLibmSteps);
+    if (n < 0) return rounded_outward(std::min(power_lo, power_hi), kInfinity, kLibmRoundingSteps, x.defined);
+    if (even) return rounded_outward(0.0, std::max(power_lo, power_hi), kLibmRoundingSteps, x.defined);
   }
   // Monotone over x: a single sign, or an odd positive power.
   const double values[] = {power_lo, power_hi};
-  Interval result = from_values(values, 2, x.defined, kLibmSteps);
+  Interval result = from_values(values, 2, x.defined, kLibmRoundingSteps);
   if (even && n > 0) result.lo = std::max(result.lo, 0.0);
   return result;
 }
@@ -122,8 +121,7 @@ Interval sqr(const Interval& x) { return integer_power(x, 2); }
 // its extremes lie at the corners of the box, limits included (pow(0, y) for y < 0 is +inf).
 Interval pow(const Interval& x, const Interval& y) {
   if (x.is_empty() || y.is_empty()) return Interval::empty(both_defined(x, y));
-  constexpr double kExactInteger = 9007199254740992.0;  // 2^53: every smaller double integer is exact
-  if (y.is_point() && std::floor(y.lo) == y.lo && std::fabs(y.lo) <= kExactInteger)
+  if (is_integer_exponent(y))
     return with_defined(integer_power(x, static_cast<long>(y.lo)), y.defined);
   bool defined = both_defined(x, y);
   Interval base = x;
@@ -137,7 +135,7 @@ Interval pow(const Interval& x, const Interval& y) {
   }
   const double corners[] = {std::pow(base.lo, y.lo), std::pow(base.lo, y.hi), std::pow(base.hi, y.lo),
                             std::pow(base.hi, y.hi)};
-  Interval result = from_values(corners, 4, defined, kLibmSteps);
+  Interval result = from_values(corners, 4, defined, kLibmRoundingSteps);
   result.lo = std::max(result.lo, 0.0);
   return result;
 }

@@ -9,16 +9,12 @@ namespace amytiss {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr int kLibmSteps = 2;  // see interval.cpp
 constexpr double kPi = M_PI;   // the double nearest pi, below it
 // Beyond this magnitude the position of x within the period is not known well enough to look for
 // extrema; sin and cos then give [-1, 1], tan the whole line.
 constexpr double kLargestReducedArgument = 1e12;
 
-Interval libm_outward(double lo, double hi, bool defined) {
-  return {std::isnan(lo) ? -kInfinity : round_down(lo, kLibmSteps), std::isnan(hi) ? kInfinity : round_up(hi, kLibmSteps),
-          defined};
-}
+Interval libm_outward(double lo, double hi, bool defined) { return rounded_outward(lo, hi, kLibmRoundingSteps, defined); }
 
 Interval clamped(Interval x, double lo, double hi) {
   x.lo = std::max(x.lo, lo);
@@ -64,7 +60,8 @@ Interval sqrt(const Interval& x) {
   const Interval domain = restricted(x, 0.0, kInfinity);
   if (domain.is_empty()) return domain;
   // sqrt is correctly rounded: one step outward suffices.
-  return {std::max(0.0, round_down(std::sqrt(domain.lo))), round_up(std::sqrt(domain.hi)), domain.defined};
+  return clamped(rounded_outward(std::sqrt(domain.lo), std::sqrt(domain.hi), kExactRoundingSteps, domain.defined), 0.0,
+                 kInfinity);
 }
 
 Interval exp(const Interval& x) {

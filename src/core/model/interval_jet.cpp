@@ -63,8 +63,7 @@ IntervalJet power(const IntervalJet& a, const IntervalJet& b) {
   const Interval value = pow(a.value, b.value);
   if (constant_in_x(b)) {
     const Interval& n = b.value;
-    const bool integer = n.is_point() && std::floor(n.lo) == n.lo && std::fabs(n.lo) < 1e15;
-    const Interval derivative = integer ? n * integer_power(a.value, static_cast<long>(n.lo) - 1)
+    const Interval derivative = is_integer_exponent(n) ? n * integer_power(a.value, static_cast<long>(n.lo) - 1)
                                         : n * pow(a.value, n - kOne);
     return chain(a, value, derivative);
   }
@@ -73,7 +72,7 @@ IntervalJet power(const IntervalJet& a, const IntervalJet& b) {
           a.smooth && b.smooth && bounded(value) && a.value.lo > 0.0};
 }
 
-IntervalJet minimum(const IntervalJet& a, const IntervalJet& b, bool is_min) {
+IntervalJet extremum(const IntervalJet& a, const IntervalJet& b, bool is_min) {
   const Interval value = is_min ? min(a.value, b.value) : max(a.value, b.value);
   const bool a_wins = is_min ? a.value.hi <= b.value.lo : a.value.lo >= b.value.hi;
   const bool b_wins = is_min ? b.value.hi <= a.value.lo : b.value.lo >= a.value.hi;
@@ -188,8 +187,8 @@ IntervalJet apply(JetOperation operation, const IntervalJet& a, const IntervalJe
     case JetOperation::And: return discrete(logical_and(u, v), dims);
     case JetOperation::Or: return discrete(logical_or(u, v), dims);
     case JetOperation::Atan2: return arc_tangent2(a, b);
-    case JetOperation::Min: return minimum(a, b, true);
-    case JetOperation::Max: return minimum(a, b, false);
+    case JetOperation::Min: return extremum(a, b, true);
+    case JetOperation::Max: return extremum(a, b, false);
     default: break;
   }
   throw std::logic_error("interval evaluation: operation of one or three operands given two");
