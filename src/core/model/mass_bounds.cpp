@@ -32,16 +32,6 @@ void require(bool invariant, const char* what) {
 
 }  // namespace
 
-double round_down(double x, int ulps) {
-  for (int i = 0; i < ulps; ++i) x = std::nextafter(x, -kInfinity);
-  return x;
-}
-
-double round_up(double x, int ulps) {
-  for (int i = 0; i < ulps; ++i) x = std::nextafter(x, kInfinity);
-  return x;
-}
-
 MassInterval remainder(const MassInterval* cells, std::size_t count) {
   if (count == 0) return {1.0, 1.0};
   double sum_lo = 0.0, sum_hi = 0.0;

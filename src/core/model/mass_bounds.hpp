@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "amytiss/grid.hpp"
+#include "amytiss/interval.hpp"
 #include "amytiss/noise.hpp"
 
 namespace amytiss {
@@ -47,9 +48,7 @@ struct DimensionBounds {
 
 /// Unit roundoff of double precision: a correctly rounded operation errs by at most this, relative.
 constexpr double kUnitRoundoff = 0x1p-53;
-/// x moved `ulps` representable doubles toward -infinity (round_down) or +infinity (round_up).
-double round_down(double x, int ulps = 1);
-double round_up(double x, int ulps = 1);
+// round_down() and round_up() (amytiss/interval.hpp) move a double outward by whole steps.
 
 /// [1 - sum hi, 1 - sum lo] clipped to [0, 1] and rounded outward (sums bounded for their rounding):
 /// the mass outside `count` cells whose masses lie in the given intervals.
