@@ -12,6 +12,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/policy_file.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -301,6 +302,36 @@ TEST(Unbounded, NearEndComponentsConverge) {
     std::printf("hovering %s: %u iterations, gap %.3g, V(1) %.12f\n", to_string(sweep).c_str(), policy.iterations,
                 policy.gap, exact[1]);
   }
+}
+
+// Safety where the state drifts right by e^-14 a step from every cell to the unsafe cell 5: the
+// value is 0, the lower bound has it at once, the upper bound crawls (no optimistic guess for
+// safety) and 100000 iterations leave a gap: the policy says it has not converged, the report
+// warns, and the policy file keeps the flag.
+TEST(Unbounded, AGapThatRemainsIsRecorded) {
+  const Abstraction a = from_yaml(
+      "name: drifting_safety\n"
+      "states: {lb: [0], ub: [5], eta: [1]}\n"
+      "dynamics: [\"x0 - 0.5\"]\n"
+      "noise: {distribution: exponential, rate: [14]}\n"
+      "spec: {type: safety, horizon: infinite, safe: {lb: [0], ub: [4]}}\n");
+  SynthesisReport report;
+  const Policy policy = run(a, DeviceKind::Reference, SweepChoice::Auto, &report);
+  EXPECT_GT(policy.gap, kTolerance);
+  EXPECT_FALSE(policy.converged);
+  for (std::size_t x = 0; x < a.states.size(); ++x) EXPECT_EQ(policy.value(0, x), 0.0) << x;
+  bool warned = false;
+  for (const auto& note : report.notes)
+    warned = warned || (note.severity == NoteSeverity::Warning && note.text.find("not reached") != std::string::npos);
+  EXPECT_TRUE(warned);
+  const std::string path = (test_support::fresh_test_directory("amytiss_unbounded_") / "drifting.h5").string();
+  write_policy_file(path, policy, a.config);
+  const LoadedPolicy loaded = read_policy_file(path);
+  EXPECT_FALSE(loaded.policy.converged);
+  EXPECT_EQ(loaded.policy.gap, policy.gap);
+  const Abstraction ruin = from_yaml(kRuin);
+  write_policy_file(path, run(ruin, DeviceKind::Reference, SweepChoice::Auto, nullptr), ruin.config);
+  EXPECT_TRUE(read_policy_file(path).policy.converged);
 }
 
 TEST(Unbounded, SeveralDevicesAreRefused) {
