@@ -82,9 +82,9 @@ struct Iteration {
         const double lost = std::max(0.0, 1.0 - host.expected(x, u, w, ones.data()) - kMassRelativeError);
         const double rise = host.expected(x, u, w, above.data());
         const double fall = host.expected(x, u, w, below.data()) + lost * guess[x];
-        const double full_covariance_error = a.noise->box_mass_tolerance() * double(supports.box_cells(r));
-        passes = rise * (1 + kMassRelativeError) + absolute_error + full_covariance_error <=
-                 fall * (1 - kMassRelativeError);
+        // Each of the three sums may be off by the row's absolute mass error.
+        const double row_error = absolute_error + a.noise->box_mass_tolerance() * double(supports.box_cells(r));
+        passes = rise * (1 + kMassRelativeError) + 3 * row_error <= fall * (1 - kMassRelativeError);
       }
       supports.for_each_cell(r, [&](std::size_t cell) { above[cell] = below[cell] = 0.0; });
       return passes;
@@ -253,7 +253,11 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
       // The input changes only when the lower bound grows by more than the step's rounding: an
       // input that is merely as good (a way to stay in an end component) makes no progress.
       if (next[x] > it.lower[x] + step.resolution()) policy_input[x] = lower_input[x];
-      if (next[x] > it.lower[x]) lower_change = std::max(lower_change, next[x] - it.lower[x]), it.lower[x] = next[x], moved = true;
+      if (next[x] > it.lower[x]) {
+        lower_change = std::max(lower_change, next[x] - it.lower[x]);
+        it.lower[x] = next[x];
+        moved = true;
+      }
     }
     step.apply(it.upper.data(), next.data(), upper_input.data());
     for (std::size_t x = 0; x < n; ++x)
