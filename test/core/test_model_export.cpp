@@ -1,6 +1,6 @@
 // Export of the finite abstraction: the files are read back by a reader written here (not the
 // writer's code), every row sums to 1, and the bounded-horizon value recomputed from the files
-// equals the reference engine's.
+// equals the reference engine's. A write that fails part-way leaves the previous export intact.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -245,6 +245,12 @@ std::map<std::string, std::string> folder_contents(const fs::path& folder) {
   return contents;
 }
 
+std::string file_sizes(const std::map<std::string, std::string>& contents) {
+  std::string text;
+  for (const auto& [name, bytes] : contents) text += name + " (" + std::to_string(bytes.size()) + " bytes) ";
+  return text;
+}
+
 // A write that fails part-way (here at a file size limit, as on a full disk) leaves the previous
 // export as it was: no truncated model.tra, no temporary file.
 TEST(ModelExport, AFailedWriteLeavesThePreviousExportIntact) {
@@ -269,7 +275,8 @@ TEST(ModelExport, AFailedWriteLeavesThePreviousExportIntact) {
   });
   EXPECT_TRUE(outcome.exited_normally()) << outcome.describe();
   EXPECT_NE(std::string::npos, outcome.message.find(std::strerror(EFBIG))) << outcome.message;
-  EXPECT_EQ(previous, folder_contents(folder));
+  const auto now = folder_contents(folder);
+  EXPECT_TRUE(previous == now) << "the previous export changed; the folder holds " << file_sizes(now);
   fs::remove_all(folder);
 }
 
