@@ -10,6 +10,8 @@ namespace {
 
 // The core driver grows its buffer in steps of this many bytes.
 constexpr std::size_t kMemoryIncrement = 1u << 20;
+// /dev/null is not a folder, so nothing exists under it.
+constexpr const char* kNoSuchFile = "/dev/null/amytiss-policy-in-memory.h5";
 
 // File image callbacks: the core driver allocates through these, and the buffer it frees when the
 // file closes is kept (Hdf5MemoryFile::Memory) instead of released, so the image is not copied.
@@ -42,8 +44,9 @@ hid_t create_in_memory(Hdf5MemoryFile::Memory& memory) {
   H5FD_file_image_callbacks_t callbacks{image_malloc,    image_memcpy,   image_realloc, image_free,
                                         share_user_data, keep_user_data, &memory};
   if (H5Pset_file_image_callbacks(access.get(), &callbacks) < 0) cannot_write("the file");
-  // Without a backing store the name only labels the file: nothing is created on disk.
-  const hid_t file = H5Fcreate("amytiss-in-memory.h5", H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
+  // Without a backing store nothing is created on disk, but HDF5 first tries to open an existing
+  // file of that name (and the core driver would read it all): the name is one no file can have.
+  const hid_t file = H5Fcreate(kNoSuchFile, H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
   if (file < 0) cannot_write("the file");
   return file;
 }
