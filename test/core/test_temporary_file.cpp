@@ -1,8 +1,9 @@
 // Temporary files and their removal on fatal signals: commit and abandon, the signal handlers'
-// three cases (default: remove and die; the program's own handler: called, nothing removed;
-// ignored: stays ignored), the dispositions restored afterwards, and orphans.
+// cases (default: remove and die; the program's own handler: called, nothing removed; ignored:
+// stays ignored; SIGXFSZ: the write fails instead), the dispositions restored afterwards, orphans.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -74,6 +75,26 @@ TEST_F(TemporaryFileTest, SigtermRemovesTheFileAndEndsTheProcess) {
     return std::string("survived SIGTERM");
   });
   EXPECT_TRUE(outcome.killed_by(SIGTERM)) << outcome.describe();
+  EXPECT_TRUE(empty());
+}
+
+TEST_F(TemporaryFileTest, AFileSizeLimitIsAnErrorNotTheEndOfTheProcess) {
+  constexpr rlim_t kLimit = 4096;
+  const auto outcome = run_in_child([&] {
+    ::signal(SIGXFSZ, SIG_DFL);  // by default, writing past the limit ends the process
+    const rlimit limit{kLimit, kLimit};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      TemporaryFile file(path("out.txt"));
+      file.stream() << std::string(2 * kLimit, 'x');
+      file.commit();
+    } catch (const FileWriteError& error) {
+      return std::string(error.what());
+    }
+    return std::string("written past the limit");
+  });
+  EXPECT_TRUE(outcome.exited_normally()) << outcome.describe();
+  EXPECT_NE(std::string::npos, outcome.message.find(std::strerror(EFBIG))) << outcome.message;
   EXPECT_TRUE(empty());
 }
 

@@ -49,7 +49,10 @@ void on_fatal_signal(int signal_number, siginfo_t* info, void* context) {
   if (previous && (previous->sa_flags & SA_SIGINFO)) {
     previous->sa_sigaction(signal_number, info, context);
   } else if (previous && previous->sa_handler == SIG_IGN) {
-    // Ignored before: stays ignored (a write past RLIMIT_FSIZE then fails with EFBIG).
+    // Ignored before: stays ignored.
+  } else if (signal_number == SIGXFSZ) {
+    // A write past the file size limit: ignored, so the write fails with EFBIG and the writer
+    // reports "File too large" and removes its file, instead of the process dumping core.
   } else if (previous && previous->sa_handler != SIG_DFL) {
     previous->sa_handler(signal_number);
   } else {

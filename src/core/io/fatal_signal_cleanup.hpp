@@ -5,7 +5,9 @@
 // SIGXFSZ are installed. A signal whose previous disposition was the default (the process ends)
 // unlinks every registered file and is raised again with the default disposition, so the process
 // ends as it would have; a signal the program handles itself goes to its handler and removes
-// nothing (the program goes on and the writer cleans up); an ignored signal stays ignored. The
+// nothing (the program goes on and the writer cleans up); an ignored signal stays ignored.
+// SIGXFSZ with the default disposition is the exception: it is ignored, so a write past the file
+// size limit fails with EFBIG and is reported like a full disk instead of ending the process. The
 // previous dispositions are restored when the last file is unregistered. SIGKILL cannot be
 // caught: TemporaryFile removes the orphans of dead processes instead.
 #include <cstddef>
