@@ -63,10 +63,19 @@ inline ChildOutcome run_in_child(const std::function<std::string()>& body,
   }
   if (started) started(child);
   char buffer[4096];
-  for (ssize_t got; (got = ::read(channel[0], buffer, sizeof buffer)) > 0;) outcome.message.append(buffer, std::size_t(got));
+  for (ssize_t got; (got = ::read(channel[0], buffer, sizeof buffer)) > 0;)
+    outcome.message.append(buffer, std::size_t(got));
   ::close(channel[0]);
   ::waitpid(child, &outcome.wait_status, 0);
   return outcome;
+}
+
+/// A pid that no process has: that of a child that has ended and been waited for.
+inline pid_t pid_of_an_ended_process() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
 }
 
 }  // namespace test_support

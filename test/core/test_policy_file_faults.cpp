@@ -116,7 +116,8 @@ TEST_F(PolicyFileFaults, AFailedRenameGivesItsReasonAndLeavesNoTemporaryFile) {
   fs::create_directories(path("occupied.h5/inside"));
   const std::string message = write_refusal(path("occupied.h5"), test_support::tiny_policy(config), config);
   EXPECT_NE(std::string::npos, message.find("rename")) << message;
-  EXPECT_NE(std::string::npos, message.find(std::strerror(EISDIR))) << message << " " << contains(std::strerror(EISDIR));
+  EXPECT_NE(std::string::npos, message.find(std::strerror(EISDIR)))
+      << message << " " << contains(std::strerror(EISDIR));
   EXPECT_EQ(std::vector<std::string>{"occupied.h5"}, entries());
 }
 
@@ -140,14 +141,6 @@ TEST_F(PolicyFileFaults, AnUnreadableFileIsReportedAsPermissionDenied) {
   EXPECT_EQ(std::string::npos, outcome.message.find("corrupt")) << outcome.message;
 }
 
-// A pid that no process has: a child that has exited and been waited for.
-pid_t dead_pid() {
-  const pid_t child = ::fork();
-  if (child == 0) ::_exit(0);
-  ::waitpid(child, nullptr, 0);
-  return child;
-}
-
 TEST_F(PolicyFileFaults, TheNextWriteRemovesTheTemporaryFileOfADeadWriter) {
   const Config config = test_support::tiny_config();
   const pid_t live_writer = ::fork();
@@ -155,9 +148,9 @@ TEST_F(PolicyFileFaults, TheNextWriteRemovesTheTemporaryFileOfADeadWriter) {
     ::pause();
     ::_exit(0);
   }
-  const std::string orphan = path("p.h5.tmp." + std::to_string(dead_pid()));
+  const std::string orphan = path("p.h5.tmp." + std::to_string(test_support::pid_of_an_ended_process()));
   const std::string of_a_live_writer = path("p.h5.tmp." + std::to_string(live_writer));
-  const std::string of_another_file = path("q.h5.tmp." + std::to_string(dead_pid()));
+  const std::string of_another_file = path("q.h5.tmp." + std::to_string(test_support::pid_of_an_ended_process()));
   for (const std::string& name : {orphan, of_a_live_writer, of_another_file}) std::ofstream(name) << "partial";
   write_policy_file(path("p.h5"), test_support::tiny_policy(config), config);
   ::kill(live_writer, SIGKILL);

@@ -131,9 +131,7 @@ TEST_F(TemporaryFileTest, TheDispositionsAreRestoredAfterTheLastFile) {
 }
 
 TEST_F(TemporaryFileTest, OrphansOfDeadProcessesAreRemovedOthersKept) {
-  const pid_t dead = ::fork();
-  if (dead == 0) ::_exit(0);
-  ::waitpid(dead, nullptr, 0);
+  const pid_t dead = test_support::pid_of_an_ended_process();
   const std::string names[] = {"out.txt.tmp." + std::to_string(dead), "out.txt.tmp.notapid",
                                "out.txt.tmp." + std::to_string(::getpid()), "other.txt.tmp." + std::to_string(dead)};
   for (const std::string& name : names) std::ofstream(path(name)) << "x";
