@@ -41,9 +41,10 @@ struct ExportSummary {
 /// the adversary moves and the self-loops. Cheap (windows only, no masses).
 std::size_t export_transition_bound(const Abstraction& abstraction);
 
-/// Writes the model into `directory` (created if missing). Throws ExportTooLarge when
-/// export_transition_bound() exceeds `max_transitions`, std::runtime_error when a file cannot be
-/// written.
+/// Writes the model into `directory` (created if missing): every file under a temporary name, all
+/// renamed once all are on the disk, so a failure leaves no partial export and a previous one
+/// intact. Throws ExportTooLarge when export_transition_bound() exceeds `max_transitions`,
+/// std::runtime_error when a file cannot be written (naming the file and the system's reason).
 ExportSummary export_model(const Abstraction& abstraction, ExportFormat format, const std::string& directory,
                            std::size_t max_transitions);
 

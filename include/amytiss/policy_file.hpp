@@ -12,8 +12,10 @@
 // An unbounded specification's stationary policy (horizon 1) adds the attributes stationary = 1
 // and iterations (interval iterations done), and /upper_values float64 (n0, n1, ...): the upper
 // bound of the optimal value; /values[0] (= /values[1]) holds the certified lower bound.
-// Every non-empty array is chunked with HDF5's Fletcher-32 checksum. Files are written to
-// "<path>.tmp.<pid>" and renamed, so a reader never sees half a file.
+// Every non-empty array is chunked with HDF5's Fletcher-32 checksum. The file is built in memory,
+// written to "<path>.tmp.<pid>", flushed and renamed, so a reader never sees half a file; a
+// terminating signal during the write removes the temporary file, and every write first removes
+// those of dead processes.
 #include <string>
 
 #include "amytiss/config.hpp"
@@ -22,7 +24,9 @@
 
 namespace amytiss {
 
-/// Writes atomically. Throws PolicyFileError on I/O failure.
+/// Writes atomically. Throws PolicyFileError on I/O failure, with the system's reason ("No space
+/// left on device", "Permission denied", ...); then no temporary file is left and an older file
+/// at `path` is intact.
 void write_policy_file(const std::string& path, const Policy& policy, const Config& config);
 
 struct LoadedPolicy {
@@ -33,9 +37,9 @@ struct LoadedPolicy {
 };
 
 /// Reads a policy file and verifies its checksums (Fletcher-32 of each array, the content digest
-/// of everything). Throws PolicyFileError when the file is missing, truncated, corrupt (a
-/// checksum does not match), not an amytiss policy or of another format version, with a message
-/// that says which.
+/// of everything). Throws PolicyFileError when the file is missing, unreadable (with the system's
+/// reason, e.g. "Permission denied"), truncated, corrupt (a checksum does not match), not an
+/// amytiss policy or of another format version, with a message that says which.
 LoadedPolicy read_policy_file(const std::string& path);
 /// Reads and checks that the file was made from `config` (same config_hash) by this build's
 /// engine version (kEngineVersion); throws PolicyFileError naming both otherwise. This decides

@@ -1,22 +1,28 @@
 // Export of the finite abstraction: the files are read back by a reader written here (not the
 // writer's code), every row sums to 1, and the bounded-horizon value recomputed from the files
-// equals the reference engine's.
+// equals the reference engine's. A write that fails part-way leaves the previous export intact.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/model_export.hpp"
+
+#include "child_process.hpp"
 
 namespace amytiss {
 namespace {
@@ -26,6 +32,9 @@ namespace fs = std::filesystem;
 constexpr double kRowSumTolerance = 1e-12;
 // The files print probabilities with 17 digits: the recomputed value differs by rounding only.
 constexpr double kValueTolerance = 1e-12;
+// A file size limit the large export's model.tra exceeds, and a transition limit no test reaches.
+constexpr std::uintmax_t kFileSizeLimit = 64 * 1024;
+constexpr std::size_t kNoTransitionLimit = 1000000;
 
 struct ReadModel {
   // choices[state][choice] = (target, probability) list
@@ -149,7 +158,7 @@ void expect_export_matches_engine(const std::string& yaml, const std::string& na
   const bool adversary = a.disturbances.dims() > 0;
   for (ExportFormat format : {ExportFormat::Prism, ExportFormat::Drn}) {
     const fs::path folder = scratch(name);
-    const ExportSummary summary = export_model(a, format, folder.string(), 1000000);
+    const ExportSummary summary = export_model(a, format, folder.string(), kNoTransitionLimit);
     const ReadModel model = format == ExportFormat::Prism ? read_prism(folder) : read_drn(folder);
     ASSERT_EQ(model.choices.size(), summary.states);
     EXPECT_TRUE(fs::exists(folder / "README.md"));
@@ -177,16 +186,20 @@ void expect_export_matches_engine(const std::string& yaml, const std::string& na
   }
 }
 
+constexpr const char* kReachAvoidYaml =
+    "name: export_reach_avoid\n"
+    "states: {lb: [-2, -2], ub: [2, 2], eta: [0.5, 0.5]}\n"
+    "inputs: {lb: [-1, -1], ub: [1, 1], eta: [1, 1]}\n"
+    "dynamics: [\"x0 + 0.5*u0\", \"x1 + 0.5*u1\"]\n"
+    "noise: {covariance: [0.04, 0.09], truncation: cutting_probability, cutting_probability: 1.0e-2}\n"
+    "spec: {type: reach_avoid, horizon: 4, target: {lb: [1, 1], ub: [2, 2]}, avoid: {lb: [-0.5, -0.5], ub: [0.5, "
+    "0.5]}}\n";
+constexpr const char* kOneDimensionalYaml =
+    "name: export_limit\nstates: {lb: [-2], ub: [2], eta: [0.25]}\ndynamics: [\"x0\"]\n"
+    "noise: {covariance: [0.1]}\nspec: {type: safety, horizon: 1}\n";
+
 TEST(ModelExport, ReachAvoidWithTruncationAndOffGridMass) {
-  expect_export_matches_engine(
-      "name: export_reach_avoid\n"
-      "states: {lb: [-2, -2], ub: [2, 2], eta: [0.5, 0.5]}\n"
-      "inputs: {lb: [-1, -1], ub: [1, 1], eta: [1, 1]}\n"
-      "dynamics: [\"x0 + 0.5*u0\", \"x1 + 0.5*u1\"]\n"
-      "noise: {covariance: [0.04, 0.09], truncation: cutting_probability, cutting_probability: 1.0e-2}\n"
-      "spec: {type: reach_avoid, horizon: 4, target: {lb: [1, 1], ub: [2, 2]}, avoid: {lb: [-0.5, -0.5], ub: [0.5, "
-      "0.5]}}\n",
-      "reach_avoid");
+  expect_export_matches_engine(kReachAvoidYaml, "reach_avoid");
 }
 
 TEST(ModelExport, SafetyWithDisturbanceAsAdversary) {
@@ -213,15 +226,57 @@ TEST(ModelExport, ExponentialNoise) {
 }
 
 TEST(ModelExport, RefusesModelsAboveTheLimit) {
-  const Abstraction a = Abstraction::from_config(config_from_yaml(YAML::Load(
-      "name: export_limit\nstates: {lb: [-2], ub: [2], eta: [0.25]}\ndynamics: [\"x0\"]\n"
-      "noise: {covariance: [0.1]}\nspec: {type: safety, horizon: 1}\n")));
+  const Abstraction a = Abstraction::from_config(config_from_yaml(YAML::Load(kOneDimensionalYaml)));
   const fs::path folder = scratch("limit");
   const std::size_t bound = export_transition_bound(a);
   EXPECT_EQ(bound, 17u * 18u + 1u);  // 17 rows of 17 cells and the sink, the sink's self-loop
   EXPECT_THROW(export_model(a, ExportFormat::Prism, folder.string(), bound - 1), ExportTooLarge);
   EXPECT_FALSE(fs::exists(folder));
   EXPECT_NO_THROW(export_model(a, ExportFormat::Prism, folder.string(), bound));
+  fs::remove_all(folder);
+}
+
+std::map<std::string, std::string> folder_contents(const fs::path& folder) {
+  std::map<std::string, std::string> contents;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    std::ifstream file(entry.path(), std::ios::binary);
+    contents[entry.path().filename().string()].assign(std::istreambuf_iterator<char>(file), {});
+  }
+  return contents;
+}
+
+std::string file_sizes(const std::map<std::string, std::string>& contents) {
+  std::string text;
+  for (const auto& [name, bytes] : contents) text += name + " (" + std::to_string(bytes.size()) + " bytes) ";
+  return text;
+}
+
+// A write that fails part-way (here at a file size limit, as on a full disk) leaves the previous
+// export as it was: no truncated model.tra, no temporary file.
+TEST(ModelExport, AFailedWriteLeavesThePreviousExportIntact) {
+  const Abstraction small = Abstraction::from_config(config_from_yaml(YAML::Load(kOneDimensionalYaml)));
+  const Abstraction large = Abstraction::from_config(config_from_yaml(YAML::Load(kReachAvoidYaml)));
+  const fs::path unlimited = scratch("unlimited"), folder = scratch("file_size_limit");
+  export_model(large, ExportFormat::Prism, unlimited.string(), kNoTransitionLimit);
+  ASSERT_GT(fs::file_size(unlimited / "model.tra"), kFileSizeLimit) << "the limit must cut the large export";
+  fs::remove_all(unlimited);
+  export_model(small, ExportFormat::Prism, folder.string(), kNoTransitionLimit);
+  const auto previous = folder_contents(folder);
+  const test_support::ChildOutcome outcome = test_support::run_in_child([&] {
+    ::signal(SIGXFSZ, SIG_IGN);  // then a write past the limit fails with EFBIG
+    const rlimit limit{kFileSizeLimit, kFileSizeLimit};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      export_model(large, ExportFormat::Prism, folder.string(), kNoTransitionLimit);
+    } catch (const std::runtime_error& error) {
+      return std::string(error.what());
+    }
+    return std::string("exported");
+  });
+  EXPECT_TRUE(outcome.exited_normally()) << outcome.describe();
+  EXPECT_NE(std::string::npos, outcome.message.find(std::strerror(EFBIG))) << outcome.message;
+  const auto now = folder_contents(folder);
+  EXPECT_TRUE(previous == now) << "the previous export changed; the folder holds " << file_sizes(now);
   fs::remove_all(folder);
 }
 

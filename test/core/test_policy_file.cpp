@@ -14,6 +14,7 @@
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
 
+#include "policy_test_data.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -23,38 +24,8 @@ namespace fs = std::filesystem;
 
 constexpr unsigned kFormatVersion = 2;  // the version this build writes
 
-Config tiny_config() {
-  Config config;
-  config.name = "policy_file_test";
-  config.states = GridSpec{{-1.0, 0.0}, {1.0, 1.5}, {0.5, 0.5}};  // 5 x 4 cells
-  config.inputs = GridSpec{{-1.0}, {1.0}, {1.0}};                 // 3 inputs
-  config.dynamics = {"x0 + 0.1*u0", "x1"};
-  config.noise.covariance = {0.1, 0.1};
-  config.spec.type = SpecType::Safety;
-  config.spec.horizon = 3;
-  return config;
-}
-
-// A hand-made policy with values that are not round in binary, so an inexact write shows.
-Policy tiny_policy(const Config& config) {
-  Policy policy;
-  policy.states = Grid(config.states);
-  policy.inputs = config.inputs ? Grid(*config.inputs) : Grid();
-  policy.horizon = config.spec.horizon;
-  const std::size_t cells = policy.states.size();
-  for (std::size_t step = 0; step <= policy.horizon; ++step)
-    for (std::size_t cell = 0; cell < cells; ++cell)
-      policy.values.push_back(std::fmod(0.1 * double(step) + std::sqrt(double(cell) / 7.0), 1.0));
-  for (std::size_t step = 0; step < policy.horizon; ++step)
-    for (std::size_t cell = 0; cell < cells; ++cell)
-      policy.input_index.push_back(std::uint32_t((cell + step) % policy.inputs.size()));
-  for (std::size_t cell = 0; cell < cells; ++cell)
-    policy.roles.push_back(CellRole(cell % 3));
-  policy.computed_by = "hand-made (test)";
-  policy.config_hash = config_hash(config);
-  policy.run_id = "0123456789abcdef";
-  return policy;
-}
+using test_support::tiny_config;
+using test_support::tiny_policy;
 
 class PolicyFileTest : public ::testing::Test {
  protected:

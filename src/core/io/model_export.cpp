@@ -6,10 +6,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "amytiss/format.hpp"
+#include "io/temporary_file.hpp"
 
 namespace amytiss {
 namespace {
@@ -164,27 +165,39 @@ std::vector<std::string> labels_of(const Abstraction& a, const ExportLayout& lay
   return labels;
 }
 
-std::ofstream open_output(const std::filesystem::path& path, ExportSummary& summary) {
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write " + path.string());
-  file.precision(17);
-  summary.files.push_back(path.string());
-  return file;
-}
+// The export's files: written under temporary names, then all flushed to the disk, then all
+// renamed, so a failure (a full disk) leaves no partial export; the destructor removes what was
+// not renamed.
+class ExportFiles {
+ public:
+  std::ostream& open(const std::filesystem::path& path, ExportSummary& summary) {
+    files_.push_back(std::make_unique<detail::TemporaryFile>(path.string()));
+    std::ostream& stream = files_.back()->stream();
+    stream.precision(17);
+    summary.files.push_back(path.string());
+    return stream;
+  }
+  void commit() {
+    for (auto& file : files_) file->finish();
+    for (auto& file : files_) file->commit();
+  }
+
+ private:
+  std::vector<std::unique_ptr<detail::TemporaryFile>> files_;
+};
 
 void write_prism(const Abstraction& a, const ExportLayout& layout, const SparseModel& model,
-                 const std::filesystem::path& folder, ExportSummary& summary) {
-  std::ofstream tra = open_output(folder / "model.tra", summary);
+                 const std::filesystem::path& folder, ExportFiles& files, ExportSummary& summary) {
+  std::ostream& tra = files.open(folder / "model.tra", summary);
   tra << summary.states << ' ' << summary.choices << ' ' << summary.transitions << '\n';
   for (std::size_t s = 0; s + 1 < model.choice_start.size(); ++s)
     for (std::size_t c = model.choice_start[s]; c < model.choice_start[s + 1]; ++c)
       for (std::size_t e = model.entry_start[c]; e < model.entry_start[c + 1]; ++e)
         tra << s << ' ' << c - model.choice_start[s] << ' ' << model.target[e] << ' ' << model.probability[e] << '\n';
-  if (!tra) throw std::runtime_error("cannot write " + (folder / "model.tra").string());
 
   // Grid indices per dimension (-1 for the sink and adversary states) and the input index of
   // adversary states (-1 elsewhere).
-  std::ofstream sta = open_output(folder / "model.sta", summary);
+  std::ostream& sta = files.open(folder / "model.sta", summary);
   sta << '(';
   for (std::size_t d = 0; d < a.states.dims(); ++d) sta << (d ? "," : "") << 'k' << d;
   sta << ",input)\n";
@@ -202,7 +215,7 @@ void write_prism(const Abstraction& a, const ExportLayout& layout, const SparseM
     sta << ',' << (s > layout.sink() ? std::to_string(adversary_input) : std::string("-1")) << ")\n";
   }
 
-  std::ofstream lab = open_output(folder / "model.lab", summary);
+  std::ostream& lab = files.open(folder / "model.lab", summary);
   const std::vector<std::string> names = label_names(a, layout);
   for (std::size_t i = 0; i < names.size(); ++i) lab << (i ? " " : "") << i << "=\"" << names[i] << '"';
   lab << '\n';
@@ -217,8 +230,8 @@ void write_prism(const Abstraction& a, const ExportLayout& layout, const SparseM
 }
 
 void write_drn(const Abstraction& a, const ExportLayout& layout, const SparseModel& model,
-               const std::filesystem::path& folder, ExportSummary& summary) {
-  std::ofstream drn = open_output(folder / "model.drn", summary);
+               const std::filesystem::path& folder, ExportFiles& files, ExportSummary& summary) {
+  std::ostream& drn = files.open(folder / "model.drn", summary);
   drn << "// amytiss abstraction of " << a.config.name << " (see README.md)\n"
       << "@type: MDP\n@parameters\n\n@reward_models\n\n@nr_states\n"
       << summary.states << "\n@nr_choices\n" << summary.choices << "\n@model\n";
@@ -232,7 +245,6 @@ void write_drn(const Abstraction& a, const ExportLayout& layout, const SparseMod
         drn << "\t\t" << model.target[e] << " : " << model.probability[e] << '\n';
     }
   }
-  if (!drn) throw std::runtime_error("cannot write " + (folder / "model.drn").string());
 }
 
 std::string readme_text(const Abstraction& a, const ExportLayout& layout, ExportFormat format,
@@ -265,10 +277,11 @@ ExportSummary export_model(const Abstraction& a, ExportFormat format, const std:
   std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error) throw std::runtime_error("cannot create the folder " + directory + ": " + error.message());
-  if (format == ExportFormat::Prism) write_prism(a, layout, model, folder, summary);
-  else write_drn(a, layout, model, folder, summary);
-  std::ofstream readme = open_output(folder / "README.md", summary);
-  readme << readme_text(a, layout, format, summary);
+  ExportFiles files;
+  if (format == ExportFormat::Prism) write_prism(a, layout, model, folder, files, summary);
+  else write_drn(a, layout, model, folder, files, summary);
+  files.open(folder / "README.md", summary) << readme_text(a, layout, format, summary);
+  files.commit();
   return summary;
 }
 
