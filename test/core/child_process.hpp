@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <functional>
@@ -37,6 +38,10 @@ inline ChildOutcome run_in_child(const std::function<std::string()>& body,
                                  const std::function<void(pid_t)>& started = nullptr) {
   int channel[2];
   if (::pipe(channel) != 0) return {-1, "pipe failed"};
+  // The child leaves through exit(), which flushes the stdio buffers it inherited: with output
+  // redirected to a file, that write would meet the child's own limits (a lowered file size
+  // limit kills it with SIGXFSZ). Nothing is left to flush when the parent flushes first.
+  std::fflush(nullptr);
   const pid_t child = ::fork();
   if (child == 0) {
     ::close(channel[0]);
