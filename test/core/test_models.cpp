@@ -7,6 +7,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include "amytiss/config.hpp"
@@ -218,7 +219,9 @@ TEST(Models, OpenclSourceCompilesAsCAndAgrees) {
   const std::string dir = ::testing::TempDir();
   for (std::size_t c = 0; c < cases.size(); ++c) {
     SCOPED_TRACE(cases[c].dynamics->describe());
-    const std::string source_path = dir + "/amytiss_model_check.c", binary_path = dir + "/amytiss_model_check";
+    // Named by process: test runs of several checkouts may share the temporary folder.
+    const std::string stem = dir + "/amytiss_model_check_" + std::to_string(::getpid());
+    const std::string source_path = stem + ".c", binary_path = stem;
     {
       std::ofstream source(source_path);
       source << "#include <math.h>\n#include <stdio.h>\n" << cases[c].dynamics->opencl_source()
