@@ -6,7 +6,8 @@
 #include <functional>
 #include <string>
 
-#include "amytiss/engine.hpp"
+#include "amytiss/policy.hpp"
+#include "amytiss/synthesis_types.hpp"
 #include "host/bellman_step.hpp"
 
 namespace amytiss::detail {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
-#include "amytiss/engine.hpp"
+#include "amytiss/synthesis_types.hpp"
 
 namespace amytiss::detail {
 
@@ -77,5 +77,15 @@ std::vector<DeviceInfo> enumerate_devices();
 /// missing: another device, with a warning note). Devices without double precision are skipped
 /// with a note. Throws DeviceError when no device matches.
 DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes);
+
+/// Label ("platform / device") of the device that `compute` selects, or "" when none matches.
+std::string selected_device_label(const ComputeConfig& compute);
+
+/// A context and an in-order command queue on one device.
+struct DeviceSession {
+  Context context;
+  Queue queue;
+};
+DeviceSession open_session(const DeviceInfo& device);
 
 }  // namespace amytiss::detail
