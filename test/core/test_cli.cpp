@@ -116,12 +116,13 @@ TEST_F(CliTest, MissingConfigurationFileExitsTwo) {
   EXPECT_CONTAINS(result.err, "absent.yaml");
 }
 
-TEST_F(CliTest, AnAbsentDeviceKindExitsOneNamingTheDevices) {
+// A request the machine cannot honour is refused like a bad configuration value (exit 2).
+TEST_F(CliTest, AnAbsentDeviceKindExitsTwoNamingTheDevices) {
   const CommandResult devices = synth("--list-devices");
   if (devices.out.find("(GPU") != std::string::npos) GTEST_SKIP() << "a GPU is present";
   const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device gpu --quiet");
-  EXPECT_EQ(1, result.exit_code);
-  EXPECT_CONTAINS(result.err, "compute.device gpu was requested");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "compute.device: got gpu, but no OpenCL gpu device");
   EXPECT_CONTAINS(result.err, "devices present");
 }
 

@@ -6,6 +6,7 @@
 #include "amytiss/errors.hpp"
 #include "amytiss/resources.hpp"
 #include "host/interval_iteration.hpp"
+#include "host/reference_step.hpp"
 
 namespace amytiss::detail {
 

@@ -9,6 +9,7 @@
 #include "amytiss/policy.hpp"
 #include "amytiss/synthesis_types.hpp"
 #include "host/bellman_step.hpp"
+#include "host/reference_step.hpp"
 
 namespace amytiss::detail {
 

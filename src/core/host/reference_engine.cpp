@@ -3,7 +3,7 @@
 #include "host/reference_engine.hpp"
 
 #include "host/backward_driver.hpp"
-#include "host/bellman_step.hpp"
+#include "host/reference_step.hpp"
 
 namespace amytiss::detail {
 

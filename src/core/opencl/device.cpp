@@ -115,22 +115,48 @@ std::vector<DeviceInfo> enumerate_devices() {
 }
 
 
+std::vector<DeviceInfo> with_double_precision(const std::vector<DeviceInfo>& devices, std::vector<EngineNote>& notes) {
+  std::vector<DeviceInfo> usable;
+  for (const DeviceInfo& info : devices) {
+    if (info.fp64)
+      usable.push_back(info);
+    else
+      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice,
+                       "skipping " + info.label() + ": no double precision (cl_khr_fp64)"});
+  }
+  return usable;
+}
+
+DeviceInfo select_device(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector,
+                         const std::string& text) {
+  std::size_t seen = 0;
+  for (const DeviceInfo& info : usable) {
+    const bool kind_matches = selector.kind == DeviceSelector::Kind::Gpu   ? info.is_gpu()
+                              : selector.kind == DeviceSelector::Kind::Cpu ? info.is_cpu()
+                                                                           : info.platform_index == selector.platform;
+    if (!kind_matches) continue;
+    if (selector.kind == DeviceSelector::Kind::Index ? info.device_index == selector.index : seen++ == selector.index)
+      return info;
+  }
+  std::string present;
+  for (const DeviceInfo& info : usable)
+    present += "\n  [" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
+               info.label() + " (" + info.type_name() + ")";
+  throw ConfigError("compute.devices", "entry '" + text + "' matches no OpenCL device with double precision (example: "
+                                       "devices: [cpu:0]); devices:" + (present.empty() ? std::string(" none") : present));
+}
+
 DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes) {
   std::vector<DeviceInfo> all = enumerate_devices();
   if (all.empty())
     throw DeviceError("no OpenCL device found (no ICD platform answered); install pocl "
                       "(Debian: pocl-opencl-icd) or use compute.device: reference");
-  std::vector<DeviceInfo> candidates;
-  for (const DeviceInfo& info : all) {
-    if (!selector_matches(compute.platform, info.platform_index, info.platform_name)) continue;
-    if (!selector_matches(compute.device_name, info.device_index, info.device_name)) continue;
-    if (!info.fp64) {
-      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice,
-                       "skipping " + info.label() + ": no double precision (cl_khr_fp64)"});
-      continue;
-    }
-    candidates.push_back(info);
-  }
+  std::vector<DeviceInfo> selected;
+  for (const DeviceInfo& info : all)
+    if (selector_matches(compute.platform, info.platform_index, info.platform_name) &&
+        selector_matches(compute.device_name, info.device_index, info.device_name))
+      selected.push_back(info);
+  const std::vector<DeviceInfo> candidates = with_double_precision(selected, notes);
   if (candidates.empty() && compute.platform.empty() && compute.device_name.empty())
     throw DeviceError("no OpenCL device with double precision found (amytiss_synth --list-devices shows the devices); "
                       "use compute.device: reference");

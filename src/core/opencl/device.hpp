@@ -73,6 +73,15 @@ struct DeviceInfo {
 /// Every device of every platform, in platform then device order.
 std::vector<DeviceInfo> enumerate_devices();
 
+/// The devices with double precision (post states and windows are computed in double); each
+/// one without is skipped with a DeviceChoice note.
+std::vector<DeviceInfo> with_double_precision(const std::vector<DeviceInfo>& devices, std::vector<EngineNote>& notes);
+
+/// The device that a compute.devices entry (`text`, parsed as `selector`) names among `usable`:
+/// the N-th GPU or CPU device, or platform P's device D. ConfigError naming the devices when none.
+DeviceInfo select_device(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector,
+                         const std::string& text);
+
 /// The device that `compute` selects (auto: the first GPU, else the first CPU device; cpu / gpu
 /// missing: another device, with a warning note). Devices without double precision are skipped
 /// with a note. Throws DeviceError when no device matches.

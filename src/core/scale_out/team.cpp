@@ -12,36 +12,6 @@
 namespace amytiss::detail {
 namespace {
 
-std::vector<DeviceInfo> with_double_precision(std::vector<EngineNote>& notes) {
-  std::vector<DeviceInfo> usable;
-  for (const DeviceInfo& info : enumerate_devices()) {
-    if (info.fp64)
-      usable.push_back(info);
-    else
-      notes.push_back(
-          {NoteSeverity::Info, NoteKind::DeviceChoice, "skipping " + info.label() + ": no double precision"});
-  }
-  return usable;
-}
-
-DeviceInfo select(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector, const std::string& text) {
-  std::size_t seen = 0;
-  for (const DeviceInfo& info : usable) {
-    const bool kind_matches = selector.kind == DeviceSelector::Kind::Gpu   ? info.is_gpu()
-                              : selector.kind == DeviceSelector::Kind::Cpu ? info.is_cpu()
-                                                                           : info.platform_index == selector.platform;
-    if (!kind_matches) continue;
-    if (selector.kind == DeviceSelector::Kind::Index ? info.device_index == selector.index : seen++ == selector.index)
-      return info;
-  }
-  std::string present;
-  for (const DeviceInfo& info : usable)
-    present += "\n  [" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
-               info.label() + " (" + info.type_name() + ")";
-  throw ConfigError("compute.devices", "entry '" + text + "' matches no OpenCL device with double precision (example: "
-                                       "devices: [cpu:0]); devices:" + (present.empty() ? std::string(" none") : present));
-}
-
 // The device split into equal sub-devices of `units` compute units each.
 std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, const std::string& text) {
   const cl_device_partition_property properties[] = {CL_DEVICE_PARTITION_EQUALLY, cl_device_partition_property(units),
@@ -76,14 +46,14 @@ std::vector<TeamDevice> open_team_devices(const ComputeConfig& compute, std::vec
   if (compute.devices.empty()) {
     team.push_back({choose_device(compute, notes), {}, 1});
   } else {
-    const std::vector<DeviceInfo> usable = with_double_precision(notes);
+    const std::vector<DeviceInfo> usable = with_double_precision(enumerate_devices(), notes);
     if (compute.devices.front() == "all") {
       if (usable.empty()) throw DeviceError("compute.devices all: no OpenCL device with double precision found");
       for (const DeviceInfo& info : usable) team.push_back({info, {}, 1});
     } else {
       for (const std::string& text : compute.devices) {
         const std::optional<DeviceSelector> selector = parse_device_selector(text);
-        const DeviceInfo info = select(usable, *selector, text);  // validate() accepted the text
+        const DeviceInfo info = select_device(usable, *selector, text);  // validate() accepted the text
         if (selector->units_per_part == 0) {
           team.push_back({info, {}, 1});
         } else {
