@@ -65,6 +65,15 @@ TEST_F(CliTest, SynthesizesTheTinyProblemAndPrintsEachPart) {
   EXPECT_EQ("reference", loaded.policy.computed_by);
 }
 
+// --dry-run prints the plan of any engine: here auto's choice of the serial engine and why.
+TEST_F(CliTest, DryRunPrintsThePlanWithTheReasonsAndWritesNothing) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device auto --dry-run --output plan.h5");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "plan: engine: reference (serial, double precision)");
+  EXPECT_CONTAINS(result.out, "plan: device auto: the serial reference engine (planned work ");
+  EXPECT_FALSE(fs::exists(path("plan.h5")));
+}
+
 TEST_F(CliTest, QuietOmitsTheProgressLines) {
   const CommandResult result =
       synth("--config " + quote(kTinyConfig) + " --device reference --quiet");
