@@ -1,73 +1,59 @@
-// synthesize(): dispatch to the reference or the OpenCL engine, with the CPU fallback of
-// docs/engine.md (a failing device is retried once on the CPU device).
+// The public entry points of the engines: each plans (plan.hpp) and carries the plan out
+// (execute.hpp), or reads the OpenCL layout and devices.
 #include "amytiss/engine.hpp"
 
-#include "amytiss/errors.hpp"
-#include "opencl/engine.hpp"
+#include "amytiss/format.hpp"
+#include "execute.hpp"
+#include "host/reference_engine.hpp"
+#include "opencl/device.hpp"
+#include "opencl/layout.hpp"
+#include "plan.hpp"
 
 namespace amytiss {
 
-namespace detail {
-
-Policy synthesize_with_cpu_fallback(const SynthesisOptions& options, SynthesisReport* report,
-                                    const EngineAttempt& attempt, const DeviceLabel& cpu_label) {
-  SynthesisReport local_report;
-  SynthesisReport& first_report = report ? *report : local_report;
-  try {
-    return attempt(options, &first_report);
-  } catch (const DeviceError& failure) {
-    // Only `auto` without a platform or device selection may run elsewhere than asked.
-    // Several devices or ranks run as asked or fail together.
-    const bool chosen_by_engine = options.compute.device == DeviceKind::Auto && options.compute.platform.empty() &&
-                                  options.compute.device_name.empty() && options.compute.devices.empty() &&
-                                  !(options.communicator && options.communicator->size() > 1);
-    if (!chosen_by_engine) throw;
-    ComputeConfig on_cpu = options.compute;
-    on_cpu.device = DeviceKind::Cpu;
-    on_cpu.platform.clear();
-    on_cpu.device_name.clear();
-    const std::string fallback_device = cpu_label(on_cpu);
-    // Running the device that just failed again would only fail again.
-    if (fallback_device.empty() || fallback_device == first_report.device) throw;
-    SynthesisReport retry_report;
-    retry_report.notes = first_report.notes;
-    retry_report.notes.push_back({NoteSeverity::Warning, NoteKind::DeviceFallback,
-                                  (first_report.device.empty() ? std::string("the device") : first_report.device) +
-                                      " failed (" + failure.what() + "); falling back to the CPU device " +
-                                      fallback_device});
-    SynthesisOptions retry_options = options;
-    retry_options.compute = on_cpu;
-    Policy policy = attempt(retry_options, &retry_report);
-    first_report = std::move(retry_report);
-    return policy;
-  }
-}
-
-}  // namespace detail
-
-namespace {
-
-Policy synthesize_on_device(const Abstraction& abstraction, const SynthesisOptions& options,
-                            SynthesisReport* report) {
-  if (options.compute.device == DeviceKind::Reference) {
-    if (report) report->notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, "device: reference (serial, double precision)"});
-    return synthesize_reference(abstraction, options.progress, report);
-  }
-  return detail::synthesize_with_cpu_fallback(
-      options, report,
-      [&abstraction](const SynthesisOptions& attempt_options, SynthesisReport* attempt_report) {
-        return detail::synthesize_opencl(abstraction, attempt_options, attempt_report);
-      },
-      detail::selected_device_label);
-}
-
-}  // namespace
-
-Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
-                  SynthesisReport* report) {
-  Policy policy = synthesize_on_device(abstraction, options, report);
+Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options, SynthesisReport* report) {
+  auto attempt = [&abstraction](const SynthesisOptions& attempt_options, SynthesisReport* attempt_report) {
+    detail::SynthesisPlan plan = detail::plan_synthesis(abstraction, attempt_options);
+    return detail::carry_out(abstraction, plan, attempt_options, {}, *attempt_report);
+  };
+  Policy policy = detail::synthesize_with_cpu_fallback(options, report, attempt, detail::selected_device_label);
   policy.run_id = new_run_id();
   return policy;
+}
+
+std::vector<std::string> describe_synthesis(const Abstraction& abstraction, const SynthesisOptions& options) {
+  detail::SynthesisPlan plan = detail::plan_synthesis(abstraction, options);
+  return detail::describe_plan(abstraction, plan, options);
+}
+
+MemoryEstimate estimate_memory(const Abstraction& abstraction) {
+  const double cells = double(abstraction.states.size());
+  const double horizon = double(abstraction.horizon);
+  MemoryEstimate estimate;
+  estimate.policy_bytes = (horizon + 1) * cells * sizeof(double) + horizon * cells * sizeof(std::uint32_t) +
+                          cells * sizeof(std::uint8_t);
+  estimate.bytes_per_triple = double(detail::Layout(abstraction).record_bytes());
+  estimate.stored_transition_bytes = estimate.bytes_per_triple * double(abstraction.triples());
+  return estimate;
+}
+
+Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallback& progress,
+                            SynthesisReport* report) {
+  SynthesisReport local_report;
+  SynthesisReport& rep = report ? *report : local_report;
+  rep.phases.clear();
+  return detail::run_reference(abstraction, progress, rep);
+}
+
+std::vector<std::string> list_opencl_devices() {
+  std::vector<std::string> lines;
+  for (const auto& info : detail::enumerate_devices()) {
+    lines.push_back("[" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
+                    info.label() + " (" + info.type_name() + ", " + format_bytes(double(info.global_memory)) + ", " +
+                    std::to_string(info.compute_units) + " compute units" +
+                    (info.fp64 ? "" : ", no double precision: unusable") + ")");
+  }
+  return lines;
 }
 
 }  // namespace amytiss

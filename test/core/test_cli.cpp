@@ -65,6 +65,15 @@ TEST_F(CliTest, SynthesizesTheTinyProblemAndPrintsEachPart) {
   EXPECT_EQ("reference", loaded.policy.computed_by);
 }
 
+// --dry-run prints the plan of any engine: here auto's choice of the serial engine and why.
+TEST_F(CliTest, DryRunPrintsThePlanWithTheReasonsAndWritesNothing) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device auto --dry-run --output plan.h5");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "plan: engine: reference (serial, double precision)");
+  EXPECT_CONTAINS(result.out, "plan: device auto: the serial reference engine (planned work ");
+  EXPECT_FALSE(fs::exists(path("plan.h5")));
+}
+
 TEST_F(CliTest, QuietOmitsTheProgressLines) {
   const CommandResult result =
       synth("--config " + quote(kTinyConfig) + " --device reference --quiet");
@@ -116,12 +125,13 @@ TEST_F(CliTest, MissingConfigurationFileExitsTwo) {
   EXPECT_CONTAINS(result.err, "absent.yaml");
 }
 
-TEST_F(CliTest, AnAbsentDeviceKindExitsOneNamingTheDevices) {
+// A request the machine cannot honour is refused like a bad configuration value (exit 2).
+TEST_F(CliTest, AnAbsentDeviceKindExitsTwoNamingTheDevices) {
   const CommandResult devices = synth("--list-devices");
   if (devices.out.find("(GPU") != std::string::npos) GTEST_SKIP() << "a GPU is present";
   const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device gpu --quiet");
-  EXPECT_EQ(1, result.exit_code);
-  EXPECT_CONTAINS(result.err, "compute.device gpu was requested");
+  EXPECT_EQ(2, result.exit_code);
+  EXPECT_CONTAINS(result.err, "compute.device: got gpu, but no OpenCL gpu device");
   EXPECT_CONTAINS(result.err, "devices present");
 }
 

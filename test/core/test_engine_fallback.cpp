@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "amytiss/errors.hpp"
-#include "opencl/engine.hpp"
+#include "execute.hpp"
 
 namespace amytiss {
 namespace {

@@ -13,8 +13,7 @@
 #include "opencl/factored/plan.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/device.hpp"
-#include "opencl/engine.hpp"
-#include "agreement.hpp"
+#include "execute.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -24,11 +23,7 @@ using detail::FactoredPlan;
 
 // Both engines sum the same exact products in another order: double rounding only.
 constexpr double kValueTolerance = 1e-9;
-// The dense sweep stores masses as float (docs/engine.md's bound); the product asks for 1e-5.
-constexpr double kDenseTolerance = 1e-5;
 constexpr double kMassTolerance = 1e-15;
-// A chosen input may differ from the reference's only where the two are valued this close.
-constexpr double kInputMarginTolerance = 1e-12;
 constexpr double kUnlimitedBudget = 1e12;
 
 using test_support::from_yaml;
@@ -182,39 +177,7 @@ TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
   EXPECT_GT(checked, 100u);
 }
 
-void expect_factored_agrees(const std::string& label, const Abstraction& a) {
-  const Policy reference = synthesize_reference(a, {}, nullptr);
-  SynthesisReport factored_report, dense_report;
-  const Policy factored = run(a, SweepChoice::Factored, &factored_report);
-  const Policy dense = run(a, SweepChoice::Dense, &dense_report);
-  EXPECT_TRUE(has_note(factored_report, "factored sweep")) << label;
-  EXPECT_FALSE(has_note(dense_report, "factored sweep: eliminates")) << label;
-  const double against_reference = max_difference(reference.values, factored.values);
-  const double against_dense = max_difference(dense.values, factored.values);
-  std::printf("[%s] pairs %zu: factored vs reference max |dV| %.3g, vs dense %.3g\n", label.c_str(), a.pairs(),
-              against_reference, against_dense);
-  EXPECT_LE(against_reference, kValueTolerance) << label;
-  EXPECT_LE(against_dense, kDenseTolerance) << label;
-  // Inputs: the reference's wherever it does not value both choices equally (ties within rounding).
-  const test_support::Agreement agreement = test_support::compare(a, reference, factored);
-  EXPECT_LE(agreement.max_mismatch_margin, kInputMarginTolerance) << label;
-  for (double value : factored.values) {
-    ASSERT_GE(value, 0.0) << label;
-    ASSERT_LE(value, 1.0) << label;
-  }
-}
-
-TEST(FactoredSweep, TrafficFewInputsWideWindowAgreesWithReferenceAndDense) {
-  expect_factored_agrees("traffic 3-d eta 0.4", from_yaml(traffic_yaml(0.4, 4)));
-}
-
-TEST(FactoredSweep, RobotWithDisturbanceAgreesWithReferenceAndDense) {
-  expect_factored_agrees("robot reach-avoid with disturbance", from_yaml(robot_disturbance_yaml()));
-}
-
-TEST(FactoredSweep, MultiplicativeNoiseAgreesWithReferenceAndDense) {
-  expect_factored_agrees("multiplicative 3-d", from_yaml(multiplicative_yaml()));
-}
+// Agreement of the factored sweep with the reference and the dense sweep: test_engine_matrix.cpp.
 
 TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
   for (const std::string& yaml : {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml()}) {

@@ -331,11 +331,13 @@ TEST(ReferenceEngine, AutonomousSystemClosedForm) {
 TEST(ReferenceEngine, ProgressReportAndCancel) {
   const Abstraction abstraction = random_walk(4);
   std::vector<unsigned> steps_seen;
+  std::vector<Phase> phases_seen;
   SynthesisReport report;
   const Policy policy = synthesize_reference(
       abstraction,
       [&](const Progress& progress) {
-        if (progress.phase == Phase::Synthesis) {
+        phases_seen.push_back(progress.phase);
+        if (progress.phase == Phase::Synthesis || progress.phase == Phase::Done) {
           steps_seen.push_back(progress.steps_done);
           EXPECT_EQ(progress.steps_total, 4u);
           EXPECT_EQ(progress.device, "reference");
@@ -345,6 +347,9 @@ TEST(ReferenceEngine, ProgressReportAndCancel) {
       },
       &report);
   EXPECT_EQ(steps_seen, (std::vector<unsigned>{1, 2, 3, 4}));
+  // Like every engine: set-up, then a step at a time, the last one reported as done.
+  EXPECT_EQ(phases_seen, (std::vector<Phase>{Phase::Setup, Phase::Synthesis, Phase::Synthesis, Phase::Synthesis,
+                                             Phase::Done}));
   EXPECT_EQ(report.device, "reference");
   ASSERT_EQ(report.phases.size(), 4u);
   EXPECT_EQ(report.phases[0].name, "step 3");

@@ -14,9 +14,9 @@
 #include "amytiss/errors.hpp"
 #include "opencl/factored/plan.hpp"
 #include "opencl/device.hpp"
-#include "opencl/engine.hpp"
+#include "execute.hpp"
 #include "scale_out/partition.hpp"
-#include "scale_out/team.hpp"
+#include "scale_out/team_factored.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -220,7 +220,7 @@ TEST(SubDevices, RecordsThatExceedOneDeviceAreStoredAcrossTwo) {
   stored.compute.transitions = TransitionStorage::Stored;
   stored.compute.memory_fraction = fraction;
   SynthesisReport refused;
-  EXPECT_THROW(detail::synthesize_opencl(a, stored, &refused), DeviceError);
+  EXPECT_THROW(detail::synthesize_opencl(a, stored, &refused), ConfigError);
   stored.compute.devices = kParts;
   SynthesisReport report;
   const Policy many = detail::synthesize_opencl(a, stored, &report);
@@ -233,7 +233,7 @@ TEST(ScaleOutPlan, DryRunDescribesSlicesMemoryAndExchange) {
   SynthesisOptions options;
   options.compute.devices = kParts;
   options.compute.sweep = SweepChoice::Dense;
-  const std::vector<std::string> lines = describe_scale_out(from_yaml(robot_yaml()), options);
+  const std::vector<std::string> lines = describe_synthesis(from_yaml(robot_yaml()), options);
   auto contains = [&](const std::string& fragment) {
     return std::any_of(lines.begin(), lines.end(),
                        [&](const std::string& l) { return l.find(fragment) != std::string::npos; });
@@ -243,7 +243,7 @@ TEST(ScaleOutPlan, DryRunDescribesSlicesMemoryAndExchange) {
   EXPECT_TRUE(contains("states [0, "));
   EXPECT_TRUE(contains("exchange per step"));
   options.compute.sweep = SweepChoice::Factored;
-  const std::vector<std::string> factored = describe_scale_out(from_yaml(chain_yaml()), options);
+  const std::vector<std::string> factored = describe_synthesis(from_yaml(chain_yaml()), options);
   EXPECT_TRUE(std::any_of(factored.begin(), factored.end(),
                           [](const std::string& l) { return l.find("stage 0") != std::string::npos; }));
 }

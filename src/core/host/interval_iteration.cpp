@@ -9,13 +9,13 @@
 #include <chrono>
 #include <cstdio>
 
+#include "amytiss/stopwatch.hpp"
 #include "host/game_graph.hpp"
 
 namespace amytiss::detail {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+using Clock = SteadyClock;
 
 constexpr unsigned kMaxIterations = 100000;
 // End components are looked for (on the host) every this many iterations.

@@ -6,8 +6,10 @@
 #include <functional>
 #include <string>
 
-#include "amytiss/engine.hpp"
+#include "amytiss/policy.hpp"
+#include "amytiss/synthesis_types.hpp"
 #include "host/bellman_step.hpp"
+#include "host/reference_step.hpp"
 
 namespace amytiss::detail {
 

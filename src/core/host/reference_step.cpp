@@ -1,9 +1,9 @@
 // The serial Bellman step: plain loops in double precision, written for clarity (it is the
 // oracle the OpenCL engine is tested against).
+#include "host/reference_step.hpp"
+
 #include <algorithm>
 #include <limits>
-
-#include "host/bellman_step.hpp"
 
 namespace amytiss::detail {
 

@@ -115,26 +115,56 @@ std::vector<DeviceInfo> enumerate_devices() {
 }
 
 
+std::vector<DeviceInfo> with_double_precision(const std::vector<DeviceInfo>& devices, std::vector<EngineNote>& notes) {
+  std::vector<DeviceInfo> usable;
+  for (const DeviceInfo& info : devices) {
+    if (info.fp64)
+      usable.push_back(info);
+    else
+      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice,
+                       "skipping " + info.label() + ": no double precision (cl_khr_fp64)"});
+  }
+  return usable;
+}
+
+DeviceInfo select_device(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector,
+                         const std::string& text) {
+  std::size_t seen = 0;
+  for (const DeviceInfo& info : usable) {
+    const bool kind_matches = selector.kind == DeviceSelector::Kind::Gpu   ? info.is_gpu()
+                              : selector.kind == DeviceSelector::Kind::Cpu ? info.is_cpu()
+                                                                           : info.platform_index == selector.platform;
+    if (!kind_matches) continue;
+    if (selector.kind == DeviceSelector::Kind::Index ? info.device_index == selector.index : seen++ == selector.index)
+      return info;
+  }
+  std::string present;
+  for (const DeviceInfo& info : usable)
+    present += "\n  [" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
+               info.label() + " (" + info.type_name() + ")";
+  throw ConfigError("compute.devices", "entry '" + text + "' matches no OpenCL device with double precision (example: "
+                                       "devices: [cpu:0]); devices:" + (present.empty() ? std::string(" none") : present));
+}
+
 DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes) {
   std::vector<DeviceInfo> all = enumerate_devices();
   if (all.empty())
     throw DeviceError("no OpenCL device found (no ICD platform answered); install pocl "
                       "(Debian: pocl-opencl-icd) or use compute.device: reference");
-  std::vector<DeviceInfo> candidates;
-  for (const DeviceInfo& info : all) {
-    if (!selector_matches(compute.platform, info.platform_index, info.platform_name)) continue;
-    if (!selector_matches(compute.device_name, info.device_index, info.device_name)) continue;
-    if (!info.fp64) {
-      notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice,
-                       "skipping " + info.label() + ": no double precision (cl_khr_fp64)"});
-      continue;
-    }
-    candidates.push_back(info);
-  }
+  std::vector<DeviceInfo> selected;
+  for (const DeviceInfo& info : all)
+    if (selector_matches(compute.platform, info.platform_index, info.platform_name) &&
+        selector_matches(compute.device_name, info.device_index, info.device_name))
+      selected.push_back(info);
+  const std::vector<DeviceInfo> candidates = with_double_precision(selected, notes);
+  if (candidates.empty() && compute.platform.empty() && compute.device_name.empty())
+    throw DeviceError("no OpenCL device with double precision found (amytiss_synth --list-devices shows the devices); "
+                      "use compute.device: reference");
   if (candidates.empty())
-    throw DeviceError("no OpenCL device with double precision matches compute.platform '" +
-                      compute.platform + "' and compute.device_name '" + compute.device_name +
-                      "' (amytiss_synth --list-devices shows the devices)");
+    throw ConfigError(compute.platform.empty() ? "compute.device_name" : "compute.platform",
+                      "no OpenCL device with double precision matches compute.platform '" + compute.platform +
+                          "' and compute.device_name '" + compute.device_name +
+                          "' (example: platform: 0; amytiss_synth --list-devices shows the devices)");
   auto first_of = [&](bool gpu) -> const DeviceInfo* {
     for (const DeviceInfo& info : candidates)
       if (gpu ? info.is_gpu() : info.is_cpu()) return &info;
@@ -143,11 +173,12 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
   const DeviceInfo* gpu = first_of(true);
   const DeviceInfo* cpu = first_of(false);
   // An explicit kind is honoured or refused, never replaced by another device.
-  auto refuse = [&](const std::string& kind) -> DeviceError {
+  auto refuse = [&](const std::string& kind) -> ConfigError {
     std::string present;
     for (const DeviceInfo& info : all) present += "\n  " + info.label() + " (" + info.type_name() + ")";
-    return DeviceError("compute.device " + kind + " was requested but no OpenCL " + kind +
-                       " device with double precision matches; devices present:" + present);
+    return ConfigError("compute.device", "got " + kind + ", but no OpenCL " + kind +
+                                             " device with double precision matches (example: device: auto); "
+                                             "devices present:" + present);
   };
   switch (compute.device) {
     case DeviceKind::Gpu:
@@ -168,6 +199,18 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
   }
 }
 
+DeviceSession open_session(const DeviceInfo& device) {
+  cl_int error = CL_SUCCESS;
+  const cl_context_properties properties[] = {CL_CONTEXT_PLATFORM,
+                                              reinterpret_cast<cl_context_properties>(device.platform), 0};
+  DeviceSession session;
+  session.context = Context(clCreateContext(properties, 1, &device.device, nullptr, nullptr, &error));
+  check(error, "clCreateContext");
+  session.queue = Queue(clCreateCommandQueue(session.context.get(), device.device, 0, &error));
+  check(error, "clCreateCommandQueue");
+  return session;
+}
+
 Kernel create_kernel(cl_program program, const char* name) {
   cl_int error = CL_SUCCESS;
   Kernel kernel(clCreateKernel(program, name, &error));
@@ -181,21 +224,11 @@ std::string selected_device_label(const ComputeConfig& compute) {
     return choose_device(compute, ignored_notes).label();
   } catch (const DeviceError&) {
     return "";
+  } catch (const ConfigError&) {
+    return "";
   }
 }
 
 }  // namespace detail
-
-std::vector<std::string> list_opencl_devices() {
-  std::vector<std::string> lines;
-  for (const auto& info : detail::enumerate_devices()) {
-    lines.push_back("[" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) +
-                    "] " + info.label() + " (" + info.type_name() + ", " +
-                    std::to_string(info.global_memory / 1048576) + " MiB, " +
-                    std::to_string(info.compute_units) + " compute units" +
-                    (info.fp64 ? "" : ", no double precision: unusable") + ")");
-  }
-  return lines;
-}
 
 }  // namespace amytiss

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
-#include "amytiss/engine.hpp"
+#include "amytiss/synthesis_types.hpp"
 
 namespace amytiss::detail {
 
@@ -73,9 +73,28 @@ struct DeviceInfo {
 /// Every device of every platform, in platform then device order.
 std::vector<DeviceInfo> enumerate_devices();
 
+/// The devices with double precision (post states and windows are computed in double); each
+/// one without is skipped with a DeviceChoice note.
+std::vector<DeviceInfo> with_double_precision(const std::vector<DeviceInfo>& devices, std::vector<EngineNote>& notes);
+
+/// The device that a compute.devices entry (`text`, parsed as `selector`) names among `usable`:
+/// the N-th GPU or CPU device, or platform P's device D. ConfigError naming the devices when none.
+DeviceInfo select_device(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector,
+                         const std::string& text);
+
 /// The device that `compute` selects (auto: the first GPU, else the first CPU device; cpu / gpu
 /// missing: another device, with a warning note). Devices without double precision are skipped
 /// with a note. Throws DeviceError when no device matches.
 DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes);
+
+/// Label ("platform / device") of the device that `compute` selects, or "" when none matches.
+std::string selected_device_label(const ComputeConfig& compute);
+
+/// A context and an in-order command queue on one device.
+struct DeviceSession {
+  Context context;
+  Queue queue;
+};
+DeviceSession open_session(const DeviceInfo& device);
 
 }  // namespace amytiss::detail

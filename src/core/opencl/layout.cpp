@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "amytiss/engine.hpp"
 
 namespace amytiss {
 namespace detail {
@@ -60,16 +59,5 @@ double contraction_multiply_adds(const Abstraction& abstraction) {
 }
 
 }  // namespace detail
-
-MemoryEstimate estimate_memory(const Abstraction& abstraction) {
-  const double cells = double(abstraction.states.size());
-  const double horizon = double(abstraction.horizon);
-  MemoryEstimate estimate;
-  estimate.policy_bytes = (horizon + 1) * cells * sizeof(double) + horizon * cells * sizeof(std::uint32_t) +
-                          cells * sizeof(std::uint8_t);
-  estimate.bytes_per_triple = double(detail::Layout(abstraction).record_bytes());
-  estimate.stored_transition_bytes = estimate.bytes_per_triple * double(abstraction.triples());
-  return estimate;
-}
 
 }  // namespace amytiss

@@ -21,40 +21,13 @@ constexpr std::size_t kMaxGroupSize = 128;
 
 std::size_t round_up(std::size_t value, std::size_t multiple) { return (value + multiple - 1) / multiple * multiple; }
 
-std::string mib(double bytes) { return std::to_string(std::llround(bytes / 1048576.0)) + " MiB"; }
-
 void set_argument(cl_kernel kernel, cl_uint index, std::size_t size, const void* value) {
   check(clSetKernelArg(kernel, index, size, value), "clSetKernelArg");
 }
 
 }  // namespace
 
-Policy empty_policy(const Abstraction& a, const std::string& device_label) {
-  Policy policy;
-  policy.states = a.states;
-  policy.inputs = a.inputs;
-  policy.horizon = a.horizon;
-  policy.roles = a.roles;
-  policy.computed_by = device_label;
-  policy.config_hash = config_hash(a.config);
-  policy.values.assign((std::size_t(a.horizon) + 1) * a.states.size(), 0.0);
-  policy.input_index.assign(std::size_t(a.horizon) * a.states.size(), 0);
-  return policy;
-}
-
-DeviceSession open_session(const DeviceInfo& device) {
-  cl_int error = CL_SUCCESS;
-  const cl_context_properties properties[] = {CL_CONTEXT_PLATFORM,
-                                              reinterpret_cast<cl_context_properties>(device.platform), 0};
-  DeviceSession session;
-  session.context = Context(clCreateContext(properties, 1, &device.device, nullptr, nullptr, &error));
-  check(error, "clCreateContext");
-  session.queue = Queue(clCreateCommandQueue(session.context.get(), device.device, 0, &error));
-  check(error, "clCreateCommandQueue");
-  return session;
-}
-
-RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& device, const SynthesisOptions& options,
+RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& device, const ComputeConfig& compute,
                  const OpenClEngineOptions& engine_options, SynthesisReport& rep, std::size_t slice_first,
                  std::size_t slice_end) {
   RunPlan plan;
@@ -68,15 +41,15 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
   const std::size_t masses_per_state = plan.records_per_state * sizeof(float) * std::size_t(layout.mass_record);
   const std::size_t value_cells = layout.padded_size + kValueSlack;
   const std::size_t base_bytes = 2 * value_cells * sizeof(double) + a.states.size() * (1 + sizeof(cl_uint));
-  const double budget = options.compute.memory_fraction * double(device.global_memory);
+  const double budget = compute.memory_fraction * double(device.global_memory);
   const double stored_bytes = double(n_states) * double(plan.records_per_state) * double(layout.record_bytes());
   const std::size_t max_states_by_allocation =
       std::max<std::size_t>(1, std::size_t(device.max_allocation / masses_per_state));
   const bool fits = double(base_bytes) + stored_bytes <= budget && masses_per_state <= device.max_allocation;
-  const std::string estimate = "stored transitions need " + mib(stored_bytes) + ", budget " + mib(budget) +
-                               " (memory_fraction " + c_double_literal(options.compute.memory_fraction) + " of " +
-                               mib(double(device.global_memory)) + ")";
-  switch (options.compute.transitions) {
+  const std::string estimate = "stored transitions need " + format_bytes(stored_bytes) + ", budget " + format_bytes(budget) +
+                               " (memory_fraction " + c_double_literal(compute.memory_fraction) + " of " +
+                               format_bytes(double(device.global_memory)) + ")";
+  switch (compute.transitions) {
     case TransitionStorage::OnTheFly:
       plan.on_the_fly = true;
       rep.transitions = "on_the_fly (requested; " + estimate + ")";
@@ -84,9 +57,9 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
     case TransitionStorage::Stored:
       // An explicit request is honoured or refused, never silently replaced.
       if (!fits)
-        throw DeviceError("compute.transitions stored was requested but the records do not fit on " +
-                          device.label() + ": " + estimate +
-                          "; use transitions: auto or on_the_fly, or a larger compute.memory_fraction");
+        throw ConfigError("compute.transitions", "got stored, but the records do not fit on " + device.label() +
+                                                     ": " + estimate +
+                                                     " (example: transitions: auto, or a larger memory_fraction)");
       rep.transitions = "stored (requested; " + estimate + ")";
       break;
     default:
@@ -160,7 +133,7 @@ RunBuffers allocate_buffers(const Abstraction& a, const Layout& layout, const Ru
                          "split into " + std::to_string(buffers.chunks.size()) + " chunks of up to " +
                              std::to_string(plan.states_per_chunk) + " states"});
   rep.device_bytes = buffers.device_bytes;
-  rep.notes.push_back({NoteSeverity::Info, NoteKind::DeviceMemory, "device memory: " + mib(double(buffers.device_bytes))});
+  rep.notes.push_back({NoteSeverity::Info, NoteKind::DeviceMemory, "device memory: " + format_bytes(double(buffers.device_bytes))});
   return buffers;
 }
 
@@ -210,6 +183,10 @@ void sweep_step(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, Ru
                             padded_values.size() * sizeof(double), padded_values.data(), 0, nullptr, nullptr),
         "clEnqueueReadBuffer");
   check(clFinish(queue), "clFinish(synthesize)");
+}
+
+void unpad(double* out, const std::vector<std::size_t>& padded_index, const double* padded) {
+  for (std::size_t x = 0; x < padded_index.size(); ++x) out[x] = padded[padded_index[x]];
 }
 
 }  // namespace amytiss::detail

@@ -1,29 +1,20 @@
 #pragma once
 // One run of the synthesis kernels on a device: where the transitions live (stored or on the
 // fly), how the sweep maps to work-items, the device buffers, the construction launches, one
-// sweep step and its read-back. opencl/engine.cpp strings these together.
+// sweep step and its read-back. opencl/engine.cpp and scale_out/team_dense.cpp
+// string these together.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
-#include "amytiss/engine.hpp"
+#include "amytiss/policy.hpp"
+#include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
-#include "opencl/engine.hpp"
+#include "opencl/engine_options.hpp"
 #include "opencl/layout.hpp"
 
 namespace amytiss::detail {
-
-/// The policy before the sweep: grids, roles, provenance (device label, configuration hash), and
-/// zeroed values and inputs for every step.
-Policy empty_policy(const Abstraction& abstraction, const std::string& device_label);
-
-/// A context and an in-order command queue on one device.
-struct DeviceSession {
-  Context context;
-  Queue queue;
-};
-DeviceSession open_session(const DeviceInfo& device);
 
 /// Storage of the transitions and decomposition of the sweep.
 struct RunPlan {
@@ -35,11 +26,12 @@ struct RunPlan {
   std::size_t slice_first = 0;       ///< the states this device sweeps: [slice_first, slice_end)
   std::size_t slice_end = 0;
 };
-/// Stored when the records fit options.compute.memory_fraction of the device memory and its
+/// Stored when the records fit compute.memory_fraction of the device memory and its
 /// allocation limit (or as requested), the sweep variant from the device type; notes say why.
 /// With several devices, `slice` is this device's states (default: all of them).
+/// A request for stored transitions that do not fit is a ConfigError naming compute.transitions.
 RunPlan plan_run(const Abstraction& abstraction, const Layout& layout, const DeviceInfo& device,
-                 const SynthesisOptions& options, const OpenClEngineOptions& engine_options,
+                 const ComputeConfig& compute, const OpenClEngineOptions& engine_options,
                  SynthesisReport& report, std::size_t slice_first = 0, std::size_t slice_end = SIZE_MAX);
 
 /// The states of one chunk and their transition records (one-element buffers on the fly).
@@ -75,5 +67,8 @@ void enqueue_sweep(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan,
 /// the padded new values into `padded_values`, and waits.
 void sweep_step(cl_command_queue queue, cl_kernel sweep, const RunPlan& plan, RunBuffers& buffers, int current,
                 std::uint32_t* input_index, std::vector<double>& padded_values);
+
+/// The values of every state cell (out, states.size()) from a padded value array.
+void unpad(double* out, const std::vector<std::size_t>& padded_index, const double* padded);
 
 }  // namespace amytiss::detail

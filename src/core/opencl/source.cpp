@@ -38,6 +38,82 @@ std::vector<long long> counts_of(const Grid& grid) {
 // (the value buffer has kValueSlack extra zero cells, so the over-read stays in bounds).
 constexpr long long kUnrollLimit = 64;
 
+// The last dimension's masses in double4 vectors inner_mass0.. (lanes past the window: 0).
+void emit_inner_masses(std::ostringstream& s, const Layout& layout) {
+  const std::size_t dims = layout.width.size();
+  const long long inner_width = layout.width[dims - 1], inner_offset = layout.mass_offset[dims - 1];
+  const long long vectors = (inner_width + 3) / 4;
+  for (long long k = 0; k < vectors; ++k) {
+    s << "  const double4 inner_mass" << k << " = ";
+    if (4 * k + 4 <= inner_width) {
+      s << "convert_double4(vload4(0, m + " << inner_offset + 4 * k << "));\n";
+    } else {
+      s << "(double4)(";
+      for (long long lane = 0; lane < 4; ++lane) {
+        const long long j = 4 * k + lane;
+        s << (lane ? ", " : "") << (j < inner_width ? "(double)m[" + std::to_string(inner_offset + j) + "]" : "0.0");
+      }
+      s << ");\n";
+    }
+  }
+}
+
+// The rows of the last dimension at `pointer`, weighted by dimension d-2's masses (a single row
+// of weight 1 when dims == 1), dotted with inner_mass*: the double `rows`.
+void emit_row_contraction(std::ostringstream& s, const Layout& layout, const std::string& pointer,
+                          const std::string& indent) {
+  const std::size_t dims = layout.width.size();
+  const long long vectors = (layout.width[dims - 1] + 3) / 4;
+  auto row_load = [&](const std::string& row_pointer, long long k) {
+    return "vload4(" + std::to_string(k) + ", " + row_pointer + ")";
+  };
+  std::vector<std::string> summed(vectors);
+  if (dims == 1) {
+    for (long long k = 0; k < vectors; ++k) summed[k] = row_load(pointer, k);
+  } else {
+    const std::size_t r = dims - 2;
+    const long long row_width = layout.width[r], row_offset = layout.mass_offset[r],
+                    row_stride = layout.padded_stride[r];
+    const bool two_sets = row_width >= 2;
+    for (long long k = 0; k < vectors; ++k) {
+      s << indent << "double4 even" << k << " = 0.0;\n";
+      if (two_sets) s << indent << "double4 odd" << k << " = 0.0;\n";
+    }
+    auto accumulate = [&](const std::string& set, const std::string& row) {
+      s << indent << "  {\n" << indent << "    const double weight = m[" << row_offset << " + " << row << "];\n"
+        << indent << "    __global const double* row = " << pointer << " + (" << row << ") * " << row_stride << ";\n";
+      for (long long k = 0; k < vectors; ++k)
+        s << indent << "    " << set << k << " = fma((double4)(weight), " << row_load("row", k) << ", " << set << k
+          << ");\n";
+      s << indent << "  }\n";
+    };
+    if (two_sets) {
+      s << indent << "for (int r = 0; r + 1 < " << row_width << "; r += 2) {\n";
+      accumulate("even", "r");
+      accumulate("odd", "r + 1");
+      s << indent << "}\n";
+    }
+    if (row_width % 2) {
+      s << indent << "{\n" << indent << "  const int r = " << row_width - 1 << ";\n";
+      accumulate("even", "r");
+      s << indent << "}\n";
+    }
+    for (long long k = 0; k < vectors; ++k)
+      summed[k] = two_sets ? "(even" + std::to_string(k) + " + odd" + std::to_string(k) + ")" : "even" + std::to_string(k);
+  }
+  std::vector<std::string> terms;
+  for (long long k = 0; k < vectors; ++k) terms.push_back("inner_mass" + std::to_string(k) + " * " + summed[k]);
+  while (terms.size() > 1) {
+    std::vector<std::string> paired;
+    for (std::size_t t = 0; t + 1 < terms.size(); t += 2) paired.push_back("(" + terms[t] + " + " + terms[t + 1] + ")");
+    if (terms.size() % 2) paired.push_back(terms.back());
+    terms = paired;
+  }
+  s << indent << "const double4 lanes = " << terms.front() << ";\n";
+  s << indent << "const double2 halves = lanes.lo + lanes.hi;\n";
+  s << indent << "const double rows = halves.x + halves.y;\n";
+}
+
 }  // namespace
 
 std::string contraction_source(const Layout& layout, const std::string& name,
@@ -48,22 +124,7 @@ std::string contraction_source(const Layout& layout, const std::string& name,
   const long long inner_width = layout.width[dims - 1], inner_offset = layout.mass_offset[dims - 1];
   const bool rows = inner_width <= kUnrollLimit;
   const std::size_t outer_levels = rows ? (dims >= 2 ? dims - 2 : 0) : dims - 1;
-  const long long vectors = (inner_width + 3) / 4;
-  if (rows) {
-    for (long long k = 0; k < vectors; ++k) {
-      s << "  const double4 inner_mass" << k << " = ";
-      if (4 * k + 4 <= inner_width) {
-        s << "convert_double4(vload4(0, m + " << inner_offset + 4 * k << "));\n";
-      } else {
-        s << "(double4)(";
-        for (long long lane = 0; lane < 4; ++lane) {
-          const long long j = 4 * k + lane;
-          s << (lane ? ", " : "") << (j < inner_width ? "(double)m[" + std::to_string(inner_offset + j) + "]" : "0.0");
-        }
-        s << ");\n";
-      }
-    }
-  }
+  if (rows) emit_inner_masses(s, layout);
   // Opens the outer loops (scalar FMA chains, zero-mass rows skipped).
   std::string pointer = "v";
   for (std::size_t i = 0; i < outer_levels; ++i) {
@@ -78,55 +139,7 @@ std::string contraction_source(const Layout& layout, const std::string& name,
   }
   const std::string indent(2 * (outer_levels + 1), ' ');
   if (rows) {
-    // The weighted rows of dimension d-2 (a single row of weight 1 when dims == 1).
-    auto row_load = [&](const std::string& row_pointer, long long k) {
-      return "vload4(" + std::to_string(k) + ", " + row_pointer + ")";
-    };
-    std::vector<std::string> summed(vectors);
-    if (dims == 1) {
-      for (long long k = 0; k < vectors; ++k) summed[k] = row_load(pointer, k);
-    } else {
-      const std::size_t r = dims - 2;
-      const long long row_width = layout.width[r], row_offset = layout.mass_offset[r],
-                      row_stride = layout.padded_stride[r];
-      const bool two_sets = row_width >= 2;
-      for (long long k = 0; k < vectors; ++k) {
-        s << indent << "double4 even" << k << " = 0.0;\n";
-        if (two_sets) s << indent << "double4 odd" << k << " = 0.0;\n";
-      }
-      auto accumulate = [&](const std::string& set, const std::string& row) {
-        s << indent << "  {\n" << indent << "    const double weight = m[" << row_offset << " + " << row << "];\n"
-          << indent << "    __global const double* row = " << pointer << " + (" << row << ") * " << row_stride << ";\n";
-        for (long long k = 0; k < vectors; ++k)
-          s << indent << "    " << set << k << " = fma((double4)(weight), " << row_load("row", k) << ", " << set << k
-            << ");\n";
-        s << indent << "  }\n";
-      };
-      if (two_sets) {
-        s << indent << "for (int r = 0; r + 1 < " << row_width << "; r += 2) {\n";
-        accumulate("even", "r");
-        accumulate("odd", "r + 1");
-        s << indent << "}\n";
-      }
-      if (row_width % 2) {
-        s << indent << "{\n" << indent << "  const int r = " << row_width - 1 << ";\n";
-        accumulate("even", "r");
-        s << indent << "}\n";
-      }
-      for (long long k = 0; k < vectors; ++k)
-        summed[k] = two_sets ? "(even" + std::to_string(k) + " + odd" + std::to_string(k) + ")" : "even" + std::to_string(k);
-    }
-    std::vector<std::string> terms;
-    for (long long k = 0; k < vectors; ++k) terms.push_back("inner_mass" + std::to_string(k) + " * " + summed[k]);
-    while (terms.size() > 1) {
-      std::vector<std::string> paired;
-      for (std::size_t t = 0; t + 1 < terms.size(); t += 2) paired.push_back("(" + terms[t] + " + " + terms[t + 1] + ")");
-      if (terms.size() % 2) paired.push_back(terms.back());
-      terms = paired;
-    }
-    s << indent << "const double4 lanes = " << terms.front() << ";\n";
-    s << indent << "const double2 halves = lanes.lo + lanes.hi;\n";
-    s << indent << "const double rows = halves.x + halves.y;\n";
+    emit_row_contraction(s, layout, pointer, indent);
   } else {
     s << indent << "double rows = 0.0;\n";
     s << indent << "for (int j = 0; j < " << inner_width << "; ++j)\n";

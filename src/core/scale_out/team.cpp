@@ -4,47 +4,13 @@
 #include "scale_out/team.hpp"
 
 #include <algorithm>
-#include <chrono>
 
 #include "amytiss/errors.hpp"
+#include "amytiss/stopwatch.hpp"
 #include "opencl/device_peak.hpp"
 
 namespace amytiss::detail {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-std::vector<DeviceInfo> with_double_precision(std::vector<EngineNote>& notes) {
-  std::vector<DeviceInfo> usable;
-  for (const DeviceInfo& info : enumerate_devices()) {
-    if (info.fp64)
-      usable.push_back(info);
-    else
-      notes.push_back(
-          {NoteSeverity::Info, NoteKind::DeviceChoice, "skipping " + info.label() + ": no double precision"});
-  }
-  return usable;
-}
-
-DeviceInfo select(const std::vector<DeviceInfo>& usable, const DeviceSelector& selector, const std::string& text) {
-  std::size_t seen = 0;
-  for (const DeviceInfo& info : usable) {
-    const bool kind_matches = selector.kind == DeviceSelector::Kind::Gpu   ? info.is_gpu()
-                              : selector.kind == DeviceSelector::Kind::Cpu ? info.is_cpu()
-                                                                           : info.platform_index == selector.platform;
-    if (!kind_matches) continue;
-    if (selector.kind == DeviceSelector::Kind::Index ? info.device_index == selector.index : seen++ == selector.index)
-      return info;
-  }
-  std::string present;
-  for (const DeviceInfo& info : usable)
-    present += "\n  [" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
-               info.label() + " (" + info.type_name() + ")";
-  throw DeviceError("compute.devices entry '" + text + "' matches no OpenCL device with double precision; devices:" +
-                    (present.empty() ? std::string(" none") : present));
-}
 
 // The device split into equal sub-devices of `units` compute units each.
 std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, const std::string& text) {
@@ -53,8 +19,9 @@ std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, c
   cl_uint count = 0;
   cl_int error = clCreateSubDevices(parent.device, properties, 0, nullptr, &count);
   if (error != CL_SUCCESS || count == 0)
-    throw DeviceError("compute.devices entry '" + text + "': " + parent.label() + " cannot be split into parts of " +
-                      std::to_string(units) + " compute units (clCreateSubDevices: " + cl_error_name(error) + ")");
+    throw ConfigError("compute.devices", "entry '" + text + "': " + parent.label() + " cannot be split into parts of " +
+                                         std::to_string(units) + " compute units (clCreateSubDevices: " +
+                                         cl_error_name(error) + "; example: cpu:0/1)");
   std::vector<cl_device_id> ids(count);
   check(clCreateSubDevices(parent.device, properties, count, ids.data(), nullptr), "clCreateSubDevices");
   // The sub-devices are not released: pocl's worker threads may still release the last events of
@@ -74,23 +41,19 @@ std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, c
 
 }  // namespace
 
-bool is_scale_out(const SynthesisOptions& options) {
-  return !options.compute.devices.empty() || (options.communicator && options.communicator->size() > 1);
-}
-
 std::vector<TeamDevice> open_team_devices(const ComputeConfig& compute, std::vector<EngineNote>& notes) {
   std::vector<TeamDevice> team;
   if (compute.devices.empty()) {
     team.push_back({choose_device(compute, notes), {}, 1});
   } else {
-    const std::vector<DeviceInfo> usable = with_double_precision(notes);
+    const std::vector<DeviceInfo> usable = with_double_precision(enumerate_devices(), notes);
     if (compute.devices.front() == "all") {
       if (usable.empty()) throw DeviceError("compute.devices all: no OpenCL device with double precision found");
       for (const DeviceInfo& info : usable) team.push_back({info, {}, 1});
     } else {
       for (const std::string& text : compute.devices) {
         const std::optional<DeviceSelector> selector = parse_device_selector(text);
-        const DeviceInfo info = select(usable, *selector, text);  // validate() accepted the text
+        const DeviceInfo info = select_device(usable, *selector, text);  // validate() accepted the text
         if (selector->units_per_part == 0) {
           team.push_back({info, {}, 1});
         } else {
@@ -132,7 +95,7 @@ Split Team::split(std::uint64_t total) const {
 
 void Team::exchange(const Split& split, std::size_t element_bytes, const std::vector<cl_mem>& buffers, void* host,
                     bool write_back) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = SteadyClock::now();
   char* bytes = static_cast<char*>(host);
   for (std::size_t i = 0; i < devices_.size(); ++i) {
     const Range range = split.devices[i];
@@ -177,19 +140,38 @@ std::vector<std::string> Team::describe(const Split& split, const std::string& w
   return lines;
 }
 
-void report_team_step(const Abstraction& a, unsigned step, double step_seconds, double multiply_adds,
-                      double synthesis_seconds, SynthesisReport& rep, const TeamProgress& progress) {
-  rep.phases.push_back({"step " + std::to_string(step), step_seconds, double(a.pairs()) / std::max(step_seconds, 1e-9),
-                        multiply_adds, 0});
-  const unsigned done = a.horizon - step;
-  if (progress)
-    progress(done == a.horizon ? Phase::Done : Phase::Synthesis, done, synthesis_seconds / done * (a.horizon - done));
+DeviceInfo Team::smallest_device() {
+  DeviceInfo smallest = devices_.front().info;
+  for (const TeamDevice& device : devices_) {
+    smallest.global_memory = std::min(smallest.global_memory, device.info.global_memory);
+    smallest.max_allocation = std::min(smallest.max_allocation, device.info.max_allocation);
+  }
+  auto least = [&](std::uint64_t value) {
+    const std::vector<double> all = communicator_.allgather_value(double(value));
+    return std::uint64_t(*std::min_element(all.begin(), all.end()));
+  };
+  smallest.global_memory = least(smallest.global_memory);
+  smallest.max_allocation = least(smallest.max_allocation);
+  return smallest;
 }
 
-void report_team_exchange(const Abstraction& a, const Team& team, SynthesisReport& rep) {
-  rep.exchange_seconds = team.exchange_seconds();
-  rep.phases.push_back(
-      {"exchange (all steps)", rep.exchange_seconds, 0, 0, rep.exchange_bytes_per_step * a.horizon, true});
+std::string Team::label() const {
+  std::string label;
+  for (const TeamDevice& device : devices_) label += (label.empty() ? "" : " + ") + device.info.label();
+  const int ranks = communicator_.size();
+  return ranks > 1 ? std::to_string(ranks) + " ranks, rank " + std::to_string(communicator_.rank()) + ": " + label
+                   : label;
+}
+
+void Team::report_exchange(double bytes_per_step, unsigned steps, SynthesisReport& report) const {
+  report.exchange_seconds = exchange_seconds_;
+  report.exchange_bytes_per_step = bytes_per_step;
+  PhaseReport phase;
+  phase.kind = PhaseKind::Breakdown;
+  phase.name = "exchange (all steps)";
+  phase.seconds = exchange_seconds_;
+  phase.bytes = bytes_per_step * steps;
+  report.phases.push_back(phase);
 }
 
 }  // namespace amytiss::detail

@@ -3,33 +3,19 @@
 // window as on one device) and the ranges are exchanged before the next stage reads them. Q is
 // split the same way, and accumulates the slices in order per entry, so it is exchanged once per
 // step; the input choice is split by states. The result is bit-identical to one device.
+#include "scale_out/team_factored.hpp"
+
 #include <algorithm>
-#include <chrono>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "amytiss/format.hpp"
-#include "opencl/factored/program.hpp"
+#include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/tables.hpp"
-#include "scale_out/team.hpp"
 
 namespace amytiss::detail {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-// Work-items [first, end) of a kernel, in launches of at most kFactoredMaxLaunchItems. The last group
-// may run past `end`: those items compute entries of another device's range, which the exchange
-// overwrites.
-void launch_range(cl_command_queue queue, cl_kernel kernel, std::uint64_t first, std::uint64_t end, std::size_t group) {
-  for (std::uint64_t offset = first; offset < end; offset += kFactoredMaxLaunchItems) {
-    const std::size_t count = std::size_t(std::min<std::uint64_t>(kFactoredMaxLaunchItems, end - offset));
-    const std::size_t global = (count + group - 1) / group * group, global_offset = std::size_t(offset);
-    check(clEnqueueNDRangeKernel(queue, kernel, 1, &global_offset, &global, &group, 0, nullptr, nullptr),
-          "clEnqueueNDRangeKernel(factored sweep)");
-  }
-}
 
 // A stage's split: parts over the team, their entries, and whether the next stage needs the
 // whole output (then it is exchanged).
@@ -70,7 +56,140 @@ void finish_all(Team& team) {
   for (TeamDevice& device : team.devices()) check(clFinish(device.session.queue.get()), "clFinish(factored sweep)");
 }
 
+// Every device's kernels and buffers (the same whole tensors on each).
+struct TeamMember {
+  FactoredKernels kernels;
+  FactoredBuffers buffers;
+};
+
+// Kernels built on every device, then the mass tables computed and sent to every device.
+std::vector<TeamMember> set_up_members(const Abstraction& a, const FactoredPlan& plan, Team& team,
+                                       const OpenClEngineOptions& engine_options, std::vector<MassTable>& tables,
+                                       StepReporter& reporter) {
+  SynthesisReport& rep = reporter.report();
+  std::vector<TeamMember> members(team.devices().size());
+  auto phase_start = SteadyClock::now();
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    TeamDevice& device = team.devices()[i];
+    members[i].kernels = build_factored_kernels(a, plan, device.info, device.session.context.get(),
+                                                engine_options.kernel_cache_dir,
+                                                engine_options.factored_entry_per_item, rep.notes);
+  }
+  reporter.phase(PhaseKind::KernelBuild, "kernel build", seconds_since(phase_start));
+  reporter.reached(Phase::Setup);
+  phase_start = SteadyClock::now();
+  tables = factored_mass_tables(a, plan);
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    members[i].buffers = allocate_factored_buffers(a, plan, tables, team.devices()[i].session.context.get());
+    rep.device_bytes = std::max(rep.device_bytes, members[i].buffers.device_bytes);
+  }
+  reporter.phase(PhaseKind::Construction, "construction", seconds_since(phase_start));
+  reporter.reached(Phase::Construction);
+  return members;
+}
+
+// One time step over the team: every slice's stages, each device computing its part of every
+// stage's entries (exchanged where the next stage needs the whole tensor), then the input choice
+// split by states, the new values and inputs exchanged.
+class FactoredTeamStep : public BellmanStep {
+ public:
+  FactoredTeamStep(const Abstraction& a, const FactoredPlan& plan, Team& team, std::vector<TeamMember>& members,
+                   double multiply_adds)
+      : a_(a), plan_(plan), team_(team), members_(members), splits_(stage_splits(plan, team)),
+        states_(team.split(a.states.size())), host_values_(factored_terminal_values(a)),
+        host_tensor_(plan.largest_stage_tensor), host_q_(plan.q_size), exchanged_(members.size()),
+        inputs_(members.size()), multiply_adds_(multiply_adds) {}
+  // Team runs compute bounded horizons only (the plan refuses the others): the devices always
+  // hold the previous step's values.
+  void apply(const double*, double*, std::uint32_t*) override {
+    throw std::logic_error("a team step runs on the values its devices hold");
+  }
+  void apply_resident(const double*, double* out, std::uint32_t* chosen) override {
+    for (std::size_t slice = 0; slice < plan_.slices; ++slice)
+      for (std::size_t k = 0; k < plan_.stages.size(); ++k) run_stage(slice, k);
+    const StageSplit& last = splits_.back();
+    if (last.exchange) team_.exchange(last.by_entry, sizeof(double), exchanged_, host_q_.data(), true);
+    choose_inputs();
+    team_.exchange(states_, sizeof(double), exchanged_, host_values_.data(), true);
+    team_.exchange(states_, sizeof(std::uint32_t), inputs_, chosen, false);
+    std::copy(host_values_.begin(), host_values_.begin() + std::ptrdiff_t(a_.states.size()), out);
+    current_ = 1 - current_;
+  }
+  double multiply_adds() const override { return multiply_adds_; }
+  const Split& states() const { return states_; }
+  double exchange_bytes() const { return exchange_bytes_per_step(a_, plan_, splits_); }
+
+ private:
+  void run_stage(std::size_t slice, std::size_t k);
+  void choose_inputs();
+
+  const Abstraction& a_;
+  const FactoredPlan& plan_;
+  Team& team_;
+  std::vector<TeamMember>& members_;
+  const std::vector<StageSplit> splits_;
+  const Split states_;
+  std::vector<double> host_values_, host_tensor_, host_q_;
+  std::vector<cl_mem> exchanged_, inputs_;
+  double multiply_adds_;
+  int current_ = 0;
+};
+
+void FactoredTeamStep::run_stage(std::size_t slice, std::size_t k) {
+  std::vector<TeamDevice>& devices = team_.devices();
+  const FactoredStage& stage = plan_.stages[k];
+  const bool last = k + 1 == plan_.stages.size();
+  const StageSplit& split = splits_[k];
+  const StagePlacement placement = stage_placement(a_, plan_, k, slice);
+  for (std::size_t i = 0; i < devices.size(); ++i) {
+    FactoredBuffers& b = members_[i].buffers;
+    cl_mem in = k == 0 ? b.values[current_].get() : b.stage_tensors[(k - 1) % 2].get();
+    cl_mem out = last ? b.q.get() : b.stage_tensors[k % 2].get();
+    exchanged_[i] = out;
+    cl_kernel kernel = members_[i].kernels.stages[k].get();
+    set_stage_arguments(kernel, in, out, b.tables[stage.dimension], placement);
+    const std::uint64_t items = stage_work_items(stage, members_[i].kernels.shape);
+    const std::uint64_t items_per_part = items / split.parts.parts;
+    const Range part = split.parts.parts == 1 ? Range{0, 1} : split.by_part.devices[i];
+    launch_range(devices[i].session.queue.get(), kernel, part.begin * items_per_part, part.end * items_per_part,
+                 factored_group_size(devices[i].info));
+    check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
+  }
+  finish_all(team_);
+  if (!last && split.exchange) team_.exchange(split.by_entry, sizeof(double), exchanged_, host_tensor_.data(), true);
+}
+
+void FactoredTeamStep::choose_inputs() {
+  std::vector<TeamDevice>& devices = team_.devices();
+  for (std::size_t i = 0; i < devices.size(); ++i) {
+    FactoredBuffers& b = members_[i].buffers;
+    cl_kernel kernel = members_[i].kernels.choose.get();
+    set_choose_arguments(kernel, b, 1 - current_);
+    launch_range(devices[i].session.queue.get(), kernel, states_.devices[i].begin, states_.devices[i].end,
+                 factored_group_size(devices[i].info));
+    check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
+    exchanged_[i] = b.values[1 - current_].get();
+    inputs_[i] = b.best_input.get();
+  }
+  finish_all(team_);
+}
+
 }  // namespace
+
+Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& team,
+                         const OpenClEngineOptions& engine_options, StepReporter& reporter) {
+  std::vector<MassTable> tables;
+  std::vector<TeamMember> members = set_up_members(a, plan, team, engine_options, tables, reporter);
+  double multiply_adds_per_step = 0;
+  for (const FactoredStage& stage : plan.stages)
+    multiply_adds_per_step += stage_multiply_adds(stage, tables[stage.dimension], plan.slices);
+  FactoredTeamStep step(a, plan, team, members, multiply_adds_per_step);
+  for (const std::string& line : team.describe(step.states(), "input choice, states"))
+    reporter.report().notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});
+  Policy policy = run_backward(a, step, reporter);
+  team.report_exchange(step.exchange_bytes(), a.horizon, reporter.report());
+  return policy;
+}
 
 StageParts stage_parts(const FactoredStage& stage, std::size_t devices) {
   StageParts parts;
@@ -98,106 +217,6 @@ bool exchange_after(const FactoredPlan& plan, const std::vector<StageParts>& par
   const bool chained = parts[k].by_major_digit && parts[k + 1].by_major_digit && !mine.post && !next.post &&
                        mine.id == next.id && mine.radix == next.radix;
   return !chained;
-}
-
-Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& team,
-                         const OpenClEngineOptions& engine_options, SynthesisReport& rep,
-                         const TeamProgress& progress) {
-  const std::size_t n_states = a.states.size();
-  std::vector<TeamDevice>& devices = team.devices();
-  auto phase_start = Clock::now();
-  std::vector<FactoredKernels> kernels;
-  for (TeamDevice& device : devices)
-    kernels.push_back(build_factored_kernels(a, plan, device.info, device.session.context.get(),
-                                             engine_options.kernel_cache_dir, engine_options.factored_entry_per_item,
-                                             rep.notes));
-  rep.phases.push_back({"kernel build", seconds_since(phase_start), 0, 0});
-  if (progress) progress(Phase::Setup, 0, -1);
-
-  phase_start = Clock::now();
-  const std::vector<MassTable> tables = factored_mass_tables(a, plan);
-  std::vector<FactoredBuffers> buffers;
-  for (TeamDevice& device : devices) {
-    buffers.push_back(allocate_factored_buffers(a, plan, tables, device.session.context.get()));
-    rep.device_bytes = std::max(rep.device_bytes, buffers.back().device_bytes);
-  }
-  rep.phases.push_back({"construction", seconds_since(phase_start), 0, 0});
-  if (progress) progress(Phase::Construction, 0, -1);
-
-  const std::vector<StageSplit> splits = stage_splits(plan, team);
-  const Split states = team.split(n_states);
-  for (const std::string& line : team.describe(states, "input choice, states"))
-    rep.notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});
-  rep.exchange_bytes_per_step = exchange_bytes_per_step(a, plan, splits);
-  double multiply_adds_per_step = 0;
-  for (const FactoredStage& stage : plan.stages)
-    multiply_adds_per_step += stage_multiply_adds(stage, tables[stage.dimension], plan.slices);
-
-  Policy policy = empty_policy(a, "");
-  std::vector<double> host_values = factored_terminal_values(a);
-  std::copy(host_values.begin(), host_values.begin() + std::ptrdiff_t(n_states),
-            policy.values.begin() + std::ptrdiff_t(std::size_t(a.horizon) * n_states));
-  std::vector<double> host_tensor(plan.largest_stage_tensor), host_q(plan.q_size);
-  std::vector<cl_mem> exchanged(devices.size());
-  const std::size_t last_stage = plan.stages.size() - 1;
-  const auto synthesis_start = Clock::now();
-  int current = 0;
-  for (unsigned step = a.horizon; step-- > 0;) {
-    phase_start = Clock::now();
-    for (std::size_t slice = 0; slice < plan.slices; ++slice) {
-      for (std::size_t k = 0; k < plan.stages.size(); ++k) {
-        const FactoredStage& stage = plan.stages[k];
-        const bool last = k == last_stage;
-        const StageSplit& split = splits[k];
-        const StagePlacement placement = stage_placement(a, plan, k, slice);
-        for (std::size_t i = 0; i < devices.size(); ++i) {
-          FactoredBuffers& b = buffers[i];
-          cl_mem in = k == 0 ? b.values[current].get() : b.stage_tensors[(k - 1) % 2].get();
-          cl_mem out = last ? b.q.get() : b.stage_tensors[k % 2].get();
-          exchanged[i] = out;
-          cl_kernel kernel = kernels[i].stages[k].get();
-          set_stage_arguments(kernel, in, out, b.tables[stage.dimension], placement);
-          const std::uint64_t items = stage_work_items(stage, kernels[i].shape);
-          const std::uint64_t items_per_part = items / split.parts.parts;
-          const Range part = split.parts.parts == 1 ? Range{0, 1} : split.by_part.devices[i];
-          const std::size_t group =
-              std::min(kFactoredGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
-          launch_range(devices[i].session.queue.get(), kernel, part.begin * items_per_part, part.end * items_per_part,
-                       group);
-          check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
-        }
-        finish_all(team);
-        if (!last && split.exchange) team.exchange(split.by_entry, sizeof(double), exchanged, host_tensor.data(), true);
-      }
-    }
-    if (splits[last_stage].exchange)
-      team.exchange(splits[last_stage].by_entry, sizeof(double), exchanged, host_q.data(), true);
-    std::vector<cl_mem> inputs(devices.size());
-    for (std::size_t i = 0; i < devices.size(); ++i) {
-      FactoredBuffers& b = buffers[i];
-      cl_kernel kernel = kernels[i].choose.get();
-      check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &b.q.handle), "clSetKernelArg");
-      check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &b.values[1 - current].handle), "clSetKernelArg");
-      check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &b.best_input.handle), "clSetKernelArg");
-      check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &b.roles.handle), "clSetKernelArg");
-      const std::size_t group = std::min(kFactoredGroupSize, std::max<std::size_t>(1, devices[i].info.max_work_group));
-      launch_range(devices[i].session.queue.get(), kernel, states.devices[i].begin, states.devices[i].end, group);
-      check(clFlush(devices[i].session.queue.get()), "clFlush(factored sweep)");
-      exchanged[i] = b.values[1 - current].get();
-      inputs[i] = b.best_input.get();
-    }
-    finish_all(team);
-    team.exchange(states, sizeof(double), exchanged, host_values.data(), true);
-    team.exchange(states, sizeof(std::uint32_t), inputs, policy.input_index.data() + std::size_t(step) * n_states,
-                  false);
-    std::copy(host_values.begin(), host_values.begin() + std::ptrdiff_t(n_states),
-              policy.values.begin() + std::ptrdiff_t(std::size_t(step) * n_states));
-    current = 1 - current;
-    report_team_step(a, step, seconds_since(phase_start), multiply_adds_per_step, seconds_since(synthesis_start), rep,
-                     progress);
-  }
-  report_team_exchange(a, team, rep);
-  return policy;
 }
 
 std::vector<std::string> describe_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& team) {

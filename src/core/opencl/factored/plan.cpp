@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numeric>
 
+#include "amytiss/format.hpp"
 #include "opencl/layout.hpp"
 
 namespace amytiss::detail {
@@ -255,11 +256,10 @@ std::string FactoredPlan::describe() const {
   for (std::size_t dim : order) text += " x'" + std::to_string(dim);
   char numbers[200];
   std::snprintf(numbers, sizeof numbers,
-                "; %.3g multiply-adds per step against %.3g for the dense sweep (%.1fx fewer); %zu slice%s; "
-                "%.0f MiB",
+                "; %.3g multiply-adds per step against %.3g for the dense sweep (%.1fx fewer); %zu slice%s; ",
                 multiply_adds, dense_multiply_adds, dense_multiply_adds / std::max(multiply_adds, 1.0), slices,
-                slices == 1 ? "" : "s", double(device_bytes) / 1048576.0);
-  text += numbers;
+                slices == 1 ? "" : "s");
+  text += numbers + format_bytes(double(device_bytes));
   text += "; reads:";
   for (std::size_t dim = 0; dim < reads.size(); ++dim) {
     text += " x'" + std::to_string(dim) + "(";
@@ -268,6 +268,88 @@ std::string FactoredPlan::describe() const {
   }
   return text;
 }
+
+namespace {
+
+// The variables each post coordinate's masses read: the states, inputs and disturbances its
+// dynamics read, and its own state under multiplicative noise (the scale is |x_dim|).
+std::vector<std::vector<std::size_t>> coordinate_reads(const Abstraction& a, const std::vector<VariableUse>& dependencies) {
+  const std::size_t dims = a.states.dims(), inputs_base = dims, disturbances_base = dims + a.inputs.dims();
+  std::vector<std::vector<std::size_t>> all;
+  for (std::size_t dim = 0; dim < dims; ++dim) {
+    const VariableUse& use = dependencies[dim];
+    std::vector<std::size_t> reads;
+    for (std::size_t i : use.states) reads.push_back(i);
+    if (a.noise->type() == NoiseType::Multiplicative) reads.push_back(dim);
+    for (std::size_t i : use.inputs) reads.push_back(inputs_base + i);
+    for (std::size_t i : use.disturbances) reads.push_back(disturbances_base + i);
+    std::sort(reads.begin(), reads.end());
+    reads.erase(std::unique(reads.begin(), reads.end()), reads.end());
+    all.push_back(std::move(reads));
+  }
+  return all;
+}
+
+// The cheapest order; among equally cheap ones, the one with the smallest tensors.
+std::vector<std::size_t> cheapest_order(const FactoredPlan& plan, const std::vector<std::size_t>& counts,
+                                        const std::vector<std::size_t>& widths, OrderCost& best_cost) {
+  std::vector<std::size_t> best_order;
+  auto consider = [&](const std::vector<std::size_t>& order) {
+    OrderCost cost = order_cost(order, plan.reads, plan.variables, counts, widths);
+    const double largest = *std::max_element(cost.sizes.begin(), cost.sizes.end());
+    const double best_largest =
+        best_order.empty() ? INFINITY : *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end());
+    if (best_order.empty() || cost.weighted < best_cost.weighted ||
+        (cost.weighted == best_cost.weighted && largest < best_largest)) {
+      best_order = order;
+      best_cost = std::move(cost);
+    }
+  };
+  const std::size_t dims = counts.size();
+  if (dims <= kExhaustiveOrderDims) {
+    std::vector<std::size_t> order(dims);
+    std::iota(order.begin(), order.end(), 0);
+    do consider(order);
+    while (std::next_permutation(order.begin(), order.end()));
+  } else {
+    consider(greedy_order(plan.reads, plan.variables, counts, widths));
+  }
+  return best_order;
+}
+
+// The fewest slices of the last eliminated dimension whose tensors fit the budget and the
+// largest buffer (plan.slices 0: none fits); sets plan.slices and plan.device_bytes.
+void choose_slices(const Abstraction& a, const OrderCost& cost, const std::vector<std::size_t>& counts,
+                   const std::vector<std::size_t>& widths, double budget_bytes, double max_buffer_bytes,
+                   FactoredPlan& plan) {
+  const std::size_t dims = counts.size();
+  double table_bytes = 0;
+  for (std::size_t dim = 0; dim < dims; ++dim) {
+    double tuples = 1;
+    for (std::size_t v : plan.reads[dim]) tuples *= double(plan.variables[v].count);
+    table_bytes += tuples * (double(widths[dim]) * sizeof(double) + 2 * sizeof(std::uint32_t));
+  }
+  const double fixed_bytes = double(sizeof(double)) * (2.0 * double(a.states.size()) + double(plan.q_size)) +
+                             double(a.states.size()) * (1 + sizeof(std::uint32_t)) + table_bytes;
+  // Stage tensors W_1..W_{d-1} hold the sliced dimension's cells: they shrink with the slice.
+  const double largest_stage = dims > 1 ? *std::max_element(cost.sizes.begin(), cost.sizes.end() - 1) : 0.0;
+  const std::size_t sliced_count = counts[plan.order.back()];
+  plan.slices = 0;
+  for (std::size_t slices = 1; slices <= sliced_count; ++slices) {
+    if (sliced_count % slices) continue;
+    if (dims == 1 && slices > 1) break;  // a single stage reads V itself: nothing to slice
+    const double bytes = fixed_bytes + 2.0 * sizeof(double) * largest_stage / double(slices);
+    const double largest_buffer =
+        sizeof(double) * std::max({largest_stage / double(slices), double(plan.q_size), double(a.states.size())});
+    if (bytes <= budget_bytes && largest_buffer <= max_buffer_bytes) {
+      plan.slices = slices;
+      plan.device_bytes = std::size_t(bytes);
+      return;
+    }
+  }
+}
+
+}  // namespace
 
 std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double budget_bytes, double max_buffer_bytes,
                                                 std::string* reason) {
@@ -281,86 +363,26 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
 
   FactoredPlan plan;
   plan.variables = grid_variables(a);
-  const std::size_t dims = a.states.dims(), inputs_base = dims, disturbances_base = dims + a.inputs.dims();
+  const std::size_t dims = a.states.dims();
   std::vector<std::size_t> counts(dims), widths(dims);
   for (std::size_t dim = 0; dim < dims; ++dim) {
     counts[dim] = a.states.count(dim);
     widths[dim] = window_width(a, dim);
-    const VariableUse& use = (*dependencies)[dim];
-    std::vector<std::size_t> reads;
-    for (std::size_t i : use.states) reads.push_back(i);
-    if (a.noise->type() == NoiseType::Multiplicative) reads.push_back(dim);  // the scale is |x_dim|
-    for (std::size_t i : use.inputs) reads.push_back(inputs_base + i);
-    for (std::size_t i : use.disturbances) reads.push_back(disturbances_base + i);
-    std::sort(reads.begin(), reads.end());
-    reads.erase(std::unique(reads.begin(), reads.end()), reads.end());
-    plan.reads.push_back(std::move(reads));
   }
-
-  // The cheapest order; among equally cheap ones, the one with the smallest tensors.
-  std::vector<std::size_t> best_order;
+  plan.reads = coordinate_reads(a, *dependencies);
   OrderCost best_cost;
-  auto consider = [&](const std::vector<std::size_t>& order) {
-    OrderCost cost = order_cost(order, plan.reads, plan.variables, counts, widths);
-    const double largest = *std::max_element(cost.sizes.begin(), cost.sizes.end());
-    const double best_largest =
-        best_order.empty() ? INFINITY : *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end());
-    if (best_order.empty() || cost.weighted < best_cost.weighted ||
-        (cost.weighted == best_cost.weighted && largest < best_largest)) {
-      best_order = order;
-      best_cost = std::move(cost);
-    }
-  };
-  if (dims <= kExhaustiveOrderDims) {
-    std::vector<std::size_t> order(dims);
-    std::iota(order.begin(), order.end(), 0);
-    do consider(order);
-    while (std::next_permutation(order.begin(), order.end()));
-  } else {
-    consider(greedy_order(plan.reads, plan.variables, counts, widths));
-  }
+  plan.order = cheapest_order(plan, counts, widths, best_cost);
   if (*std::max_element(best_cost.sizes.begin(), best_cost.sizes.end()) > kMaxTensorEntries)
     return refuse("its tensors would exceed 64-bit indexing");
-
-  plan.order = best_order;
   plan.multiply_adds = best_cost.multiply_adds;
   plan.dense_multiply_adds = double(a.states.size()) * double(a.inputs.size()) * double(a.disturbances.size()) *
                              contraction_multiply_adds(a);
   plan.q_size = std::uint64_t(best_cost.sizes.back());
-
-  double table_bytes = 0;
-  for (std::size_t dim = 0; dim < dims; ++dim) {
-    double tuples = 1;
-    for (std::size_t v : plan.reads[dim]) tuples *= double(plan.variables[v].count);
-    table_bytes += tuples * (double(widths[dim]) * sizeof(double) + 2 * sizeof(std::uint32_t));
-  }
-  const double fixed_bytes = double(sizeof(double)) * (2.0 * double(a.states.size()) + double(plan.q_size)) +
-                             double(a.states.size()) * (1 + sizeof(std::uint32_t)) + table_bytes;
-  // Stage tensors W_1..W_{d-1} hold the sliced dimension's cells: they shrink with the slice.
-  const double largest_stage =
-      dims > 1 ? *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end() - 1) : 0.0;
-  const std::size_t sliced_count = counts[plan.order.back()];
-  plan.slices = 0;
-  for (std::size_t slices = 1; slices <= sliced_count; ++slices) {
-    if (sliced_count % slices) continue;
-    if (dims == 1 && slices > 1) break;  // a single stage reads V itself: nothing to slice
-    const double bytes = fixed_bytes + 2.0 * sizeof(double) * largest_stage / double(slices);
-    const double largest_buffer =
-        sizeof(double) * std::max({largest_stage / double(slices), double(plan.q_size), double(a.states.size())});
-    if (bytes <= budget_bytes && largest_buffer <= max_buffer_bytes) {
-      plan.slices = slices;
-      plan.device_bytes = std::size_t(bytes);
-      break;
-    }
-  }
-  if (plan.slices == 0) {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "its tensors need more than the budget of %.0f MiB (or buffers above %.0f MiB) even in slices",
-                  budget_bytes / 1048576.0, max_buffer_bytes / 1048576.0);
-    return refuse(text);
-  }
-  plan.slice_cells = sliced_count / plan.slices;
+  choose_slices(a, best_cost, counts, widths, budget_bytes, max_buffer_bytes, plan);
+  if (plan.slices == 0)
+    return refuse("its tensors need more than the budget of " + format_bytes(budget_bytes) + " (or buffers above " +
+                  format_bytes(max_buffer_bytes) + ") even in slices");
+  plan.slice_cells = counts[plan.order.back()] / plan.slices;
   plan.stages = build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells);
   for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
     plan.largest_stage_tensor = std::max(plan.largest_stage_tensor, plan.stages[k].output_size);

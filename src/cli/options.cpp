@@ -1,0 +1,81 @@
+#include "options.hpp"
+
+#include <cstdlib>
+#include <vector>
+
+namespace amytiss::cli {
+
+const char* const kUsage =
+    "usage: amytiss_synth --config FILE [options]\n"
+    "\n"
+    "Synthesizes a controller (policy) for the configuration's specification and writes it as\n"
+    "an HDF5 policy file (docs/policy_file.md).\n"
+    "\n"
+    "options:\n"
+    "  --config FILE                      YAML configuration (docs/configuration.md)\n"
+    "  --device auto|cpu|gpu|reference    overrides compute.device\n"
+    "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
+    "  --sweep auto|dense|factored        overrides compute.sweep (docs/engine.md)\n"
+    "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
+    "  --devices all|LIST                 overrides compute.devices: several devices, comma-separated\n"
+    "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
+    "  --dry-run                          print the plan (engine, devices, sweep, work split), compute nothing\n"
+    "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
+    "  --profile                          per-phase timing, rates and memory table\n"
+    "  --compare-reference                also run the serial reference engine and compare V_0\n"
+    "  --export prism|drn DIR             write the finite abstraction (PRISM explicit files or Storm\n"
+    "                                     DRN, with a README) into DIR and exit (docs/export.md)\n"
+    "  --export-max-transitions N         refuse to export more transitions (default 10000000)\n"
+    "  --list-devices                     list the OpenCL devices and exit\n"
+    "  --quiet                            no progress lines\n"
+    "  --help                             this text\n"
+    "\n"
+    "Under mpirun (a build with MPI) the ranks split the synthesis; rank 0 prints and writes the file.\n"
+    "\n"
+    "exit status: 0 success, 2 bad input (configuration or options), 1 other failures\n";
+
+
+Options parse_options(int argc, char** argv) {
+  Options options;
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value (see --help)");
+      return args[++i];
+    };
+    if (arg == "--config") options.config_path = value();
+    else if (arg == "--device") options.device = value();
+    else if (arg == "--transitions") options.transitions = value();
+    else if (arg == "--sweep") options.sweep = value();
+    else if (arg == "--platform") options.platform = value();
+    else if (arg == "--devices") options.devices = value();
+    else if (arg == "--dry-run") options.dry_run = true;
+    else if (arg == "--output" || arg == "-o") options.output = value();
+    else if (arg == "--export") {
+      options.export_format = value();
+      options.export_directory = value();
+      if (options.export_format != "prism" && options.export_format != "drn")
+        throw UsageError("--export: got '" + options.export_format + "', expected prism or drn (example: --export "
+                         "prism out/)");
+    } else if (arg == "--export-max-transitions") {
+      const std::string text = value();
+      char* end = nullptr;
+      const unsigned long long limit = std::strtoull(text.c_str(), &end, 10);
+      if (text.empty() || *end != '\0' || text[0] == '-')
+        throw UsageError("--export-max-transitions: got '" + text + "', expected a whole number (example: 50000000)");
+      options.export_max_transitions = std::size_t(limit);
+    }
+    else if (arg == "--profile") options.profile = true;
+    else if (arg == "--compare-reference") options.compare_reference = true;
+    else if (arg == "--list-devices") options.list_devices = true;
+    else if (arg == "--quiet" || arg == "-q") options.quiet = true;
+    else if (arg == "--help" || arg == "-h") options.help = true;
+    else throw UsageError("unknown option '" + arg + "' (see --help)");
+  }
+  if (!options.help && !options.list_devices && options.config_path.empty())
+    throw UsageError("--config FILE is required (example: --config config/robot_safety.yaml)");
+  return options;
+}
+
+}  // namespace amytiss::cli

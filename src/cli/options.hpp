@@ -1,0 +1,40 @@
+#pragma once
+// amytiss_synth's command line: its options, their parsing and the usage text.
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace amytiss::cli {
+
+/// The usage text of --help.
+extern const char* const kUsage;
+
+// Bad command-line input; reported like a configuration error (exit status 2).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string config_path;
+  std::string device;       // empty: the configuration's
+  std::string transitions;  // empty: the configuration's
+  std::string sweep;        // empty: the configuration's
+  std::string platform;
+  std::string devices;      // empty: the configuration's
+  std::string output;
+  std::string export_format;  // empty: no export
+  std::string export_directory;
+  std::size_t export_max_transitions = 10000000;
+  bool dry_run = false;
+  bool profile = false;
+  bool compare_reference = false;
+  bool list_devices = false;
+  bool quiet = false;
+  bool help = false;
+};
+
+/// The options of argv; UsageError for an unknown option, a missing value or a missing --config.
+Options parse_options(int argc, char** argv);
+
+}  // namespace amytiss::cli

@@ -1,0 +1,197 @@
+#include "printing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "amytiss/engine.hpp"
+#include "amytiss/enum_names.hpp"
+#include "amytiss/format.hpp"
+#include "amytiss/stopwatch.hpp"
+
+namespace amytiss::cli {
+namespace {
+
+std::string counts_text(const Grid& grid) {
+  if (grid.dims() == 0) return "";
+  std::string text = " (";
+  for (std::size_t dim = 0; dim < grid.dims(); ++dim)
+    text += (dim ? " x " : "") + std::to_string(grid.count(dim));
+  return text + ")";
+}
+
+}  // namespace
+
+std::string format_seconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, seconds < 10 ? "%.3f s" : "%.1f s", seconds);
+  return text;
+}
+
+void print_sizes(const Abstraction& abstraction) {
+  std::printf("grid: states %zu%s, inputs %zu%s, disturbances %zu%s\n",
+              abstraction.states.size(), counts_text(abstraction.states).c_str(),
+              abstraction.inputs.size(), counts_text(abstraction.inputs).c_str(),
+              abstraction.disturbances.size(), counts_text(abstraction.disturbances).c_str());
+  std::printf("state-input pairs: %zu, state-input-disturbance triples: %zu, horizon: %u\n",
+              abstraction.pairs(), abstraction.triples(), abstraction.horizon);
+}
+
+// The engine's estimate (docs/engine.md): policy arrays as in the file, stored transitions as
+// the OpenCL engine stores them.
+void print_memory_estimate(const Abstraction& abstraction) {
+  const MemoryEstimate estimate = estimate_memory(abstraction);
+  std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",
+              format_bytes(estimate.policy_bytes).c_str(), format_bytes(estimate.stored_transition_bytes).c_str(),
+              estimate.bytes_per_triple);
+}
+
+// What the abstraction may lose or add per transition: truncation only ever drops mass (values
+// stay lower bounds); a custom density's quadrature may err either way, at most T times its bound
+// in V_0 (docs/semantics.md).
+void print_error_budget(const Abstraction& abstraction) {
+  const NoiseModel& noise = *abstraction.noise;
+  std::printf("noise: %s %s, truncation %s: cut mass <= %.3g per transition", to_string(noise.type()).c_str(),
+              to_string(noise.distribution()).c_str(), to_string(abstraction.config.noise.truncation).c_str(),
+              noise.cut_mass_bound());
+  if (noise.quadrature_error_bound() > 0)
+    std::printf(", quadrature error <= %.3g per transition (|dV_0| <= %.3g over the horizon)",
+                noise.quadrature_error_bound(), noise.quadrature_error_bound() * double(abstraction.horizon));
+  if (!noise.separable()) std::printf(", box mass tolerance %.3g", noise.box_mass_tolerance());
+  std::printf("\n");
+}
+
+bool print_progress(const Progress& progress, bool quiet) {
+  const bool step_done = progress.phase == Phase::Synthesis || (progress.phase == Phase::Done && progress.steps_total);
+  if (quiet || !step_done) return true;
+  if (progress.steps_total == 0) {  // unbounded: interval iterations, no fixed count; every 100th
+    if (progress.steps_done % 100 != 0) return true;
+    std::printf("  iteration %u on %s, elapsed %s\n", progress.steps_done, progress.device.c_str(),
+                format_seconds(progress.elapsed_s).c_str());
+    std::fflush(stdout);
+    return true;
+  }
+  std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
+              progress.steps_total, progress.percent(), progress.device.c_str(),
+              format_seconds(progress.elapsed_s).c_str());
+  if (progress.remaining_s >= 0)
+    std::printf(", remaining %s", format_seconds(progress.remaining_s).c_str());
+  std::printf("\n");
+  std::fflush(stdout);
+  return true;
+}
+
+double compute_seconds(const SynthesisReport& report) {
+  double total = 0;
+  for (const auto& phase : report.phases)
+    if (!phase.is_breakdown() && !phase.is_setup()) total += phase.seconds;
+  return total;
+}
+
+// Without --profile the time steps are summed into one line.
+void print_phase_times(const SynthesisReport& report) {
+  double step_seconds = 0;
+  std::size_t steps = 0;
+  for (const auto& phase : report.phases) {
+    if (phase.is_breakdown()) continue;
+    if (phase.kind == PhaseKind::Step) {
+      step_seconds += phase.seconds;
+      ++steps;
+    } else {
+      std::printf("  %-24s %s\n", phase.name.c_str(), format_seconds(phase.seconds).c_str());
+    }
+  }
+  if (steps > 0)
+    std::printf("  %-24s %s\n", ("synthesis (" + std::to_string(steps) + " steps)").c_str(),
+                format_seconds(step_seconds).c_str());
+}
+
+// Every kernel finishes before its phase's clock stops (profile), so the rates are the device's.
+void print_profile(const SynthesisReport& report) {
+  const double peak = report.peak_multiply_adds_per_second;
+  std::printf("profile (%s):\n", report.device.c_str());
+  if (peak > 0)
+    std::printf("  double multiply-add peak %.0f GMAC/s: %s\n", peak / 1e9, report.peak_basis.c_str());
+  std::printf("  %-28s %10s %14s %14s %9s %7s %11s\n", "phase", "seconds", "pairs/s", "multiply-adds", "GMAC/s",
+              "% peak", "GB/s (ops)");
+  auto print_row = [&](const std::string& name, double seconds, double pairs_per_second, double multiply_adds,
+                       double bytes) {
+    const double rate = seconds > 0 ? multiply_adds / seconds : 0.0;
+    std::printf("  %-28s %10.4f %14.4g %14.4g %9.3f %7.2f %11.2f\n", name.c_str(), seconds, pairs_per_second,
+                multiply_adds, rate / 1e9, peak > 0 ? 100.0 * rate / peak : 0.0,
+                seconds > 0 ? bytes / seconds / 1e9 : 0.0);
+  };
+  double total_seconds = 0, total_multiply_adds = 0, total_bytes = 0;
+  for (const auto& phase : report.phases) {
+    if (!phase.is_breakdown()) {
+      total_seconds += phase.seconds;
+      total_multiply_adds += phase.multiply_adds;
+      total_bytes += phase.bytes;
+    }
+    print_row((phase.is_breakdown() ? "  " : "") + phase.name, phase.seconds, phase.pairs_per_second,
+              phase.multiply_adds, phase.bytes);
+  }
+  print_row("total", total_seconds, 0, total_multiply_adds, total_bytes);
+  std::printf("  device memory: %s, host peak (VmHWM): %s\n",
+              format_bytes(double(report.device_bytes)).c_str(),
+              format_bytes(double(std::max(report.host_peak_bytes, peak_resident_bytes()))).c_str());
+}
+
+void print_value_summary(const Policy& policy) {
+  const ValueSummary summary = summarize_initial_values(policy);
+  std::printf("V_0 over %zu free cells: min %.6f, mean %.6f, max %.6f; %zu cells with V_0 >= 0.5\n",
+              summary.free_cells, summary.min, summary.mean, summary.max,
+              summary.cells_at_least_half);
+  if (!policy.stationary) return;
+  // Unbounded: V_0 above is the certified lower bound; the upper bound and the gap beside it.
+  double upper_max = 0, upper_sum = 0;
+  std::size_t free_cells = 0;
+  for (std::size_t cell = 0; cell < policy.states.size(); ++cell) {
+    if (policy.roles[cell] != CellRole::Free) continue;
+    upper_max = std::max(upper_max, policy.upper_values[cell]);
+    upper_sum += policy.upper_values[cell];
+    ++free_cells;
+  }
+  std::printf("unbounded: V_0 is the stationary policy's certified lower bound; upper bound mean %.6f, max %.6f; "
+              "largest gap %.3g after %u interval iterations\n",
+              free_cells ? upper_sum / double(free_cells) : 0.0, upper_max, policy.gap, policy.iterations);
+}
+
+void compare_with_reference(const Abstraction& abstraction, const Policy& policy,
+                            double engine_seconds, double engine_compute_seconds, bool quiet) {
+  std::printf("reference engine (for comparison):\n");
+  const auto start = SteadyClock::now();
+  SynthesisReport reference_report;
+  const Policy reference = synthesize_reference(
+      abstraction, [quiet](const Progress& progress) { return print_progress(progress, quiet); },
+      &reference_report);
+  const double reference_seconds = seconds_since(start);
+  double max_difference = 0;
+  for (std::size_t cell = 0; cell < policy.states.size(); ++cell)
+    max_difference =
+        std::max(max_difference, std::fabs(policy.value(0, cell) - reference.value(0, cell)));
+  std::printf("  reference time %s; engine %s end to end, %s compute\n",
+              format_seconds(reference_seconds).c_str(), format_seconds(engine_seconds).c_str(),
+              format_seconds(engine_compute_seconds).c_str());
+  std::printf("  speed-up %.1fx end to end, %.1fx compute\n",
+              engine_seconds > 0 ? reference_seconds / engine_seconds : 0.0,
+              engine_compute_seconds > 0 ? reference_seconds / engine_compute_seconds : 0.0);
+  std::printf("  max |dV_0| (engine - reference): %.3g\n", max_difference);
+}
+
+
+// Each rank's synthesis time and the share of it spent exchanging parts (rank 0 prints).
+void print_rank_times(double synthesis_seconds, const SynthesisReport& report, Communicator* communicator) {
+  SoloCommunicator solo;
+  Communicator& ranks = communicator ? *communicator : solo;
+  const std::vector<double> seconds = ranks.allgather_value(synthesis_seconds);
+  const std::vector<double> exchange = ranks.allgather_value(report.exchange_seconds);
+  if (report.exchange_bytes_per_step <= 0) return;
+  std::printf("scale-out: %s exchanged per step\n", format_bytes(report.exchange_bytes_per_step).c_str());
+  for (std::size_t r = 0; r < seconds.size(); ++r)
+    std::printf("  rank %zu: synthesize() %s, exchange %s (%.1f%%)\n", r, format_seconds(seconds[r]).c_str(),
+                format_seconds(exchange[r]).c_str(), seconds[r] > 0 ? 100.0 * exchange[r] / seconds[r] : 0.0);
+}
+
+
+}  // namespace amytiss::cli

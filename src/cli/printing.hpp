@@ -1,0 +1,37 @@
+#pragma once
+// amytiss_synth's output: the problem's sizes, the progress lines, the wall-time and profile
+// tables, the value summary and the comparison with the reference engine (docs/cli.md).
+#include <string>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/policy.hpp"
+#include "amytiss/scale_out.hpp"
+#include "amytiss/synthesis_types.hpp"
+
+namespace amytiss::cli {
+
+/// "0.123 s" below 10 s, else "12.3 s".
+std::string format_seconds(double seconds);
+/// Grid sizes, pairs and triples, and the horizon.
+void print_sizes(const Abstraction& abstraction);
+/// The engine's memory estimate (docs/engine.md).
+void print_memory_estimate(const Abstraction& abstraction);
+/// The noise law, the truncation's cut mass and the quadrature error bound per transition.
+void print_error_budget(const Abstraction& abstraction);
+/// A progress line per time step (unbounded: per 100th iteration) unless quiet; always true.
+bool print_progress(const Progress& progress, bool quiet);
+/// Seconds of construction and synthesis, without set-up and breakdowns (the compute time).
+double compute_seconds(const SynthesisReport& report);
+/// The phases' wall times, the time steps summed into one line.
+void print_phase_times(const SynthesisReport& report);
+/// Per phase: seconds, pairs/s, multiply-adds, GMAC/s, share of the peak, GB/s; and the memory.
+void print_profile(const SynthesisReport& report);
+/// V_0 over the free cells (unbounded: also the upper bound and the gap).
+void print_value_summary(const Policy& policy);
+/// Runs the reference engine too and prints the speed-up and max |dV_0|.
+void compare_with_reference(const Abstraction& abstraction, const Policy& policy, double engine_seconds,
+                            double engine_compute_seconds, bool quiet);
+/// Each rank's synthesis time and the share of it spent exchanging parts. Collective.
+void print_rank_times(double synthesis_seconds, const SynthesisReport& report, Communicator* communicator);
+
+}  // namespace amytiss::cli

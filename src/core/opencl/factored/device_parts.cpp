@@ -1,0 +1,119 @@
+// The factored sweep's device pieces that one device and a team share.
+#include "opencl/factored/device_parts.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "opencl/factored/tables.hpp"
+#include "opencl/program_cache.hpp"
+
+namespace amytiss::detail {
+
+// Every tuple of the contracted dimension's table occurs output_size / tuples times per slice,
+// with its kept cells.
+double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, std::size_t slices) {
+  const double kept = std::accumulate(table.count.begin(), table.count.end(), 0.0);
+  return double(stage.output_size) * double(slices) / double(table.count.size()) * kept;
+}
+
+StagePlacement stage_placement(const Abstraction& a, const FactoredPlan& plan, std::size_t k, std::size_t slice) {
+  // V's stride of the sliced dimension (row-major over the state grid).
+  std::uint64_t sliced_stride = 1;
+  for (std::size_t r = plan.order.back() + 1; r < a.states.dims(); ++r) sliced_stride *= a.states.count(r);
+  const bool last = k + 1 == plan.stages.size();
+  const cl_uint block_first = cl_uint(slice * plan.slice_cells);
+  StagePlacement placement;
+  placement.in_offset = (k == 0 && !last) ? cl_ulong(block_first) * sliced_stride : 0;
+  placement.lo = last ? block_first : 0;
+  placement.hi = last ? cl_uint(block_first + plan.slice_cells) : cl_uint(a.states.count(plan.stages[k].dimension));
+  placement.accumulate = last && slice > 0;
+  return placement;
+}
+
+void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
+                         const StagePlacement& placement) {
+  check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &in), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &out), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &table.first.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &table.count.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 4, sizeof(cl_mem), &table.masses.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 5, sizeof(cl_ulong), &placement.in_offset), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 6, sizeof(cl_uint), &placement.lo), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 7, sizeof(cl_uint), &placement.hi), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
+}
+
+FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,
+                                       cl_context context, const std::string& cache_dir, bool entry_per_item,
+                                       std::vector<EngineNote>& notes) {
+  FactoredKernels kernels;
+  kernels.shape = stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+  notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                   std::string("factored stages: ") +
+                       (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
+                                                   : "one entry per work-item, neighbours contiguous (SIMT device)")});
+  kernels.program = build_program(context, device, factored_program_source(a, plan, kernels.shape), cache_dir, notes);
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    kernels.stages.push_back(create_kernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str()));
+  kernels.choose = create_kernel(kernels.program.get(), "choose_inputs");
+  return kernels;
+}
+
+std::vector<double> factored_terminal_values(const Abstraction& a) {
+  std::vector<double> terminal(a.states.size() + kTensorSlack, 0.0);
+  for (std::size_t x = 0; x < a.states.size(); ++x) terminal[x] = a.terminal_value(a.roles[x]);
+  return terminal;
+}
+
+FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPlan& plan,
+                                          const std::vector<MassTable>& tables, cl_context context) {
+  const std::size_t n_states = a.states.size();
+  FactoredBuffers buffers;
+  cl_int error = CL_SUCCESS;
+  auto make_buffer = [&](cl_mem_flags flags, std::size_t bytes, const void* host) {
+    Buffer buffer(clCreateBuffer(context, flags, std::max<std::size_t>(bytes, 8), const_cast<void*>(host), &error));
+    check(error, "clCreateBuffer");
+    buffers.device_bytes += bytes;
+    return buffer;
+  };
+  for (const MassTable& table : tables) {
+    const cl_mem_flags flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+    buffers.tables.push_back({make_buffer(flags, table.first.size() * sizeof(cl_uint), table.first.data()),
+                              make_buffer(flags, table.count.size() * sizeof(cl_uint), table.count.data()),
+                              make_buffer(flags, table.masses.size() * sizeof(double), table.masses.data())});
+  }
+  std::vector<cl_uchar> roles(n_states);
+  for (std::size_t x = 0; x < n_states; ++x) roles[x] = static_cast<cl_uchar>(a.roles[x]);
+  const std::vector<double> terminal = factored_terminal_values(a);
+  buffers.roles = make_buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n_states, roles.data());
+  for (Buffer& values : buffers.values)
+    values = make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data());
+  buffers.best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
+  buffers.q = make_buffer(CL_MEM_READ_WRITE, plan.q_size * sizeof(double), nullptr);
+  if (plan.stages.size() > 1)
+    for (Buffer& tensor : buffers.stage_tensors)
+      tensor = make_buffer(CL_MEM_READ_WRITE, (plan.largest_stage_tensor + kTensorSlack) * sizeof(double), nullptr);
+  return buffers;
+}
+
+void launch_range(cl_command_queue queue, cl_kernel kernel, std::uint64_t first, std::uint64_t end, std::size_t group) {
+  for (std::uint64_t offset = first; offset < end; offset += kFactoredMaxLaunchItems) {
+    const std::size_t count = std::size_t(std::min<std::uint64_t>(kFactoredMaxLaunchItems, end - offset));
+    const std::size_t global = (count + group - 1) / group * group, global_offset = std::size_t(offset);
+    check(clEnqueueNDRangeKernel(queue, kernel, 1, &global_offset, &global, &group, 0, nullptr, nullptr),
+          "clEnqueueNDRangeKernel(factored sweep)");
+  }
+}
+
+std::size_t factored_group_size(const DeviceInfo& device) {
+  return std::min(kFactoredGroupSize, std::max<std::size_t>(1, device.max_work_group));
+}
+
+void set_choose_arguments(cl_kernel kernel, FactoredBuffers& buffers, int output) {
+  check(clSetKernelArg(kernel, 0, sizeof(cl_mem), &buffers.q.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 1, sizeof(cl_mem), &buffers.values[output].handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 2, sizeof(cl_mem), &buffers.best_input.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 3, sizeof(cl_mem), &buffers.roles.handle), "clSetKernelArg");
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,130 @@
+// One place decides how a synthesis runs; the reasons become notes, so that a run, its report
+// and --dry-run all say the same thing.
+#include "plan.hpp"
+
+#include <cstdio>
+
+#include "amytiss/errors.hpp"
+#include "amytiss/format.hpp"
+#include "opencl/layout.hpp"
+#include "opencl/run.hpp"
+#include "opencl/sweep_choice.hpp"
+#include "scale_out/team_dense.hpp"
+#include "scale_out/team_factored.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+// `auto` runs the serial engine when the planned work over the horizon is at most this many
+// multiply-adds: the serial engine does 3e7 to 2e8 of them per second (its masses cost most on
+// small windows), so it is done in about a second at worst, while building an OpenCL program
+// with an empty kernel cache takes about 2 s on pocl (BENCHMARKS.md).
+constexpr double kSerialMultiplyAdds = 3e7;
+// Unbounded specifications iterate until the bounds meet; the plan counts this many steps.
+constexpr double kPlannedUnboundedSteps = 100;
+
+std::string scientific(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+void note(SynthesisPlan& plan, const std::string& text) {
+  plan.notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, text});
+}
+
+// `auto`'s choice by the planned work: the serial engine when an OpenCL build would dominate.
+bool serial_pays(const Abstraction& a, SynthesisPlan& plan) {
+  const double steps = a.unbounded ? kPlannedUnboundedSteps : double(a.horizon);
+  const double total = plan.multiply_adds_per_step * steps;
+  const std::string work = "planned work " + scientific(plan.multiply_adds_per_step) + " multiply-adds per step, " +
+                           scientific(total) + " in all";
+  if (total <= kSerialMultiplyAdds) {
+    note(plan, "device auto: the serial reference engine (" + work + ", at most " + scientific(kSerialMultiplyAdds) +
+                   ": building an OpenCL program would take longer than the synthesis)");
+    return true;
+  }
+  note(plan, "device auto: an OpenCL device (" + work + ", above the serial engine's " +
+                 scientific(kSerialMultiplyAdds) + ")");
+  return false;
+}
+
+void plan_team(const Abstraction& a, const SynthesisOptions& options, SynthesisPlan& plan) {
+  if (a.unbounded)
+    throw ConfigError("spec.horizon", "infinite (interval iteration) runs on one OpenCL device or on compute.device: "
+                                      "reference; several devices (compute.devices) and MPI ranks compute bounded "
+                                      "horizons only (example: horizon: 16)");
+  plan.engine = EngineKind::Team;
+  plan.team = std::make_unique<TeamSetup>();
+  Communicator& ranks = options.communicator ? *options.communicator : plan.team->solo;
+  plan.team->team = std::make_unique<Team>(open_team_devices(options.compute, plan.notes), ranks);
+  plan.factored = choose_sweep(a, plan.team->team->smallest_device(), options.compute, plan.notes);
+}
+
+}  // namespace
+
+std::string to_string(EngineKind engine) {
+  switch (engine) {
+    case EngineKind::Reference: return "reference (serial, double precision)";
+    case EngineKind::OneDevice: return "OpenCL, one device";
+    case EngineKind::Team: return "OpenCL, several devices or ranks";
+  }
+  return "?";
+}
+
+bool is_scale_out(const SynthesisOptions& options) {
+  return !options.compute.devices.empty() || (options.communicator && options.communicator->size() > 1);
+}
+
+bool chosen_by_engine(const SynthesisOptions& options) {
+  const ComputeConfig& compute = options.compute;
+  return compute.device == DeviceKind::Auto && compute.platform.empty() && compute.device_name.empty() &&
+         !is_scale_out(options);
+}
+
+double planned_multiply_adds_per_step(const Abstraction& a) {
+  std::size_t free_cells = 0;
+  for (CellRole role : a.roles) free_cells += role == CellRole::Free;
+  return double(free_cells) * double(a.inputs.size()) * double(a.disturbances.size()) * contraction_multiply_adds(a);
+}
+
+SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& options, EngineScope scope) {
+  SynthesisPlan plan;
+  plan.multiply_adds_per_step = planned_multiply_adds_per_step(a);
+  const bool any = scope == EngineScope::Any;
+  if (any && options.compute.device == DeviceKind::Reference) {
+    note(plan, "device: reference (serial, double precision)");
+    return plan;
+  }
+  if (any && chosen_by_engine(options) && serial_pays(a, plan)) return plan;
+  check_opencl_supported(a);
+  if (is_scale_out(options)) {
+    plan_team(a, options, plan);
+  } else {
+    plan.engine = EngineKind::OneDevice;
+    plan.device = choose_device(options.compute, plan.notes);
+    plan.may_fall_back = chosen_by_engine(options);
+    plan.factored = choose_sweep(a, plan.device, options.compute, plan.notes);
+  }
+  if (!plan.factored) check_dense_supported(Layout(a));
+  return plan;
+}
+
+std::vector<std::string> describe_plan(const Abstraction& a, SynthesisPlan& plan, const SynthesisOptions& options) {
+  std::vector<std::string> lines = {"engine: " + to_string(plan.engine)};
+  for (const EngineNote& note : plan.notes) lines.push_back(note.text);
+  if (plan.engine == EngineKind::OneDevice && !plan.factored) {
+    SynthesisReport storage;
+    plan_run(a, Layout(a), plan.device, options.compute, {}, storage);
+    lines.push_back("transitions: " + storage.transitions);
+  }
+  if (plan.engine != EngineKind::Team) return lines;
+  Team& team = *plan.team->team;
+  lines.push_back("devices: " + team.label());
+  const std::vector<std::string> split =
+      plan.factored ? describe_factored_team(a, *plan.factored, team) : describe_dense_team(a, team, options.compute);
+  lines.insert(lines.end(), split.begin(), split.end());
+  return lines;
+}
+
+}  // namespace amytiss::detail
