@@ -52,6 +52,21 @@ class SynthesizerAndServerTest : public ::testing::Test {
     EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
     return *action_.getResult();
   }
+  /// A goal's result and the status that reports it (the status topic and the action's result
+  /// arrive in either order: the latest status right after the result may still be an older one).
+  struct GoalOutcome {
+    amytiss::SynthesizeResult result;
+    amytiss::PolicyStatus status;
+  };
+  GoalOutcome run_goal_with_status(const amytiss::SynthesizeGoal& goal) {
+    const StatusMark before = status_.mark();
+    GoalOutcome outcome;
+    outcome.result = run_goal(goal);
+    const auto status = status_.wait_for_outcome(before, outcome.result.message, kPolicyWaitSeconds);
+    EXPECT_TRUE(status.has_value()) << "no status says: " << outcome.result.message.substr(0, 500);
+    if (status) outcome.status = *status;
+    return outcome;
+  }
 
   ros::NodeHandle handle_;
   StatusWatcher status_{handle_};
