@@ -16,7 +16,7 @@ using amytiss_test::kActionWaitSeconds;
 using amytiss_test::kSlowConfig;
 using Client = actionlib::SimpleActionClient<amytiss::SynthesizeAction>;
 using ResynthesisTest = amytiss_test::SynthesizerAndServerTest;
-using GoalOutcome = ResynthesisTest::GoalOutcome;
+using amytiss_test::GoalOutcome;
 
 TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
   const amytiss::PolicyStatus before = status_.latest();

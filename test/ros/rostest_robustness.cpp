@@ -16,6 +16,7 @@ namespace {
 
 constexpr double kNoticeWaitSeconds = 20.0;
 const std::string kSynthesizer = "/amytiss/synthesizer";
+using amytiss_test::GoalOutcome;
 
 std::string repeat(const std::string& piece, std::size_t times) {
   std::string text;

@@ -18,6 +18,16 @@
 namespace {
 
 constexpr double kExitWaitSeconds = 30.0;
+// About 250,000 cells and one input, horizon 20: a few seconds of synthesis, and a policy file of
+// about 80 MB whose write takes long enough (seconds) for a SIGINT to land during it.
+constexpr const char* kBigFileConfig = R"YAML(
+name: big_file_write
+states:  {lb: [-5, -5], ub: [5, 5], eta: [0.02, 0.02]}
+inputs:  {lb: [-0.5], ub: [0.5], eta: [1.0]}
+dynamics: ["x0 + u0", "x1"]
+noise: {type: additive, distribution: normal, covariance: [0.0004, 0.0004], truncation: cutting_probability, cutting_probability: 1.0e-3}
+spec: {type: reach_avoid, horizon: 20, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
+)YAML";
 const std::string kSynthesizer = "/amytiss/synthesizer";
 
 std::string file_bytes(const std::string& path) {
@@ -81,11 +91,11 @@ class ShutdownTest : public ::testing::Test {
     old_bytes_ = file_bytes(policy_file_);
     ASSERT_FALSE(old_bytes_.empty());
   }
-  /// Sends the slow goal, interrupts the synthesizer once a status meets `when`, and expects a
-  /// clean exit.
-  void interrupt_goal_when(const std::function<bool(const amytiss::PolicyStatus&)>& when) {
+  /// Sends a goal for `config_yaml`, interrupts the synthesizer once a status meets `when`, and
+  /// expects a clean exit.
+  void interrupt_goal_when(const std::string& config_yaml, const std::function<bool(const amytiss::PolicyStatus&)>& when) {
     amytiss::SynthesizeGoal goal;
-    goal.config_yaml = amytiss_test::kSlowConfig;
+    goal.config_yaml = config_yaml;
     goal.force = true;
     action_.sendGoal(goal);
     ASSERT_TRUE(status_.wait_for(when, amytiss_test::kActionWaitSeconds)) << status_.latest().message;
@@ -110,20 +120,21 @@ class ShutdownTest : public ::testing::Test {
 
 TEST_F(ShutdownTest, InterruptedDuringTheSynthesisExitsCleanlyAndKeepsTheOldFile) {
   interrupt_goal_when(
-      [](const amytiss::PolicyStatus& s) { return s.synthesizing && s.phase == "synthesis" && s.percent > 0; });
+      amytiss_test::kSlowConfig, [](const amytiss::PolicyStatus& s) { return s.synthesizing && s.phase == "synthesis" && s.percent > 0; });
   EXPECT_EQ(old_bytes_, file_bytes(policy_file_)) << "the old policy file changed";
   expect_no_temporary_file();
 }
 
 TEST_F(ShutdownTest, InterruptedWhileWritingExitsCleanlyAndLeavesAWholeFile) {
-  interrupt_goal_when([](const amytiss::PolicyStatus& s) { return s.message.rfind("writing ", 0) == 0; });
+  interrupt_goal_when(kBigFileConfig,
+                      [](const amytiss::PolicyStatus& s) { return s.message.rfind("writing ", 0) == 0; });
   // The write is not interrupted: the file is the old one or the complete new one.
   amytiss::LoadedPolicy loaded;
   ASSERT_NO_THROW(loaded = amytiss::read_policy_file(policy_file_));
   if (loaded.config_hash == old_config_hash_)
     EXPECT_EQ(old_bytes_, file_bytes(policy_file_));
   else
-    EXPECT_NE(std::string::npos, loaded.config_yaml.find("slow_for_cancel")) << loaded.config_yaml.substr(0, 200);
+    EXPECT_NE(std::string::npos, loaded.config_yaml.find("big_file_write")) << loaded.config_yaml.substr(0, 200);
   expect_no_temporary_file();
 }
 
