@@ -7,6 +7,8 @@
 //   topic   status (amytiss/PolicyStatus, latched): progress, errors, and each new policy;
 //           republished every ~heartbeat_period_s as a heartbeat.
 //   topic   /diagnostics (diagnostic_updater): synthesis state, device, the ready policy.
+// SIGINT / SIGTERM (the node's main) and rosnode kill end in shutdown(): exit status 0, the
+// policy file whole.
 // Private parameters: the configuration schema (docs/configuration.md), plus
 //   ~policy_file (string, default $ROS_HOME/amytiss/<name>.h5, ROS_HOME defaults to ~/.ros),
 //   ~device (string, overrides compute.device when not empty: auto | cpu | gpu | reference),
