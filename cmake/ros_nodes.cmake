@@ -48,7 +48,7 @@ if(CATKIN_ENABLE_TESTING)
   endif()
 
   # Node-level tests (map_server's rtest style): one gtest node per .test file.
-  foreach(rostest_name service resynthesis closed_loop robustness restart)
+  foreach(rostest_name service resynthesis closed_loop robustness restart shutdown)
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/rostest_${rostest_name}.cpp)
       add_rostest_gtest(amytiss_rostest_${rostest_name} test/ros/${rostest_name}.test
                         test/ros/rostest_${rostest_name}.cpp)

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "amytiss/errors.hpp"
 #include "amytiss/noise.hpp"
 
 namespace amytiss_ros {
@@ -14,6 +15,10 @@ PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
   const std::size_t n = state_dims_;
   noise_factor_.assign(n * n, 0.0);
   const auto& noise = config.noise;
+  if (noise.distribution != amytiss::Distribution::Normal && noise.distribution != amytiss::Distribution::Uniform)
+    throw amytiss::ConfigError("noise.distribution", "the plant simulator cannot draw " +
+                                                         amytiss::to_string(noise.distribution) +
+                                                         " noise yet (it draws normal and uniform noise)");
   if (noise.distribution == amytiss::Distribution::Uniform) {
     for (std::size_t i = 0; i < n; ++i) noise_factor_[i * n + i] = noise.half_width.at(i);
     return;
@@ -30,28 +35,33 @@ PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
 }
 
 std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {
-  const std::size_t n = state_dims_;
   std::vector<double> disturbance;
   if (config_.disturbances) {
     for (std::size_t i = 0; i < config_.disturbances->lb.size(); ++i)
       disturbance.push_back(
           std::uniform_real_distribution<double>(config_.disturbances->lb[i], config_.disturbances->ub[i])(random_));
   }
-  std::vector<double> next(n);
+  std::vector<double> next(state_dims_);
   dynamics_->evaluate(state.data(), input.empty() ? nullptr : input.data(),
                       disturbance.empty() ? nullptr : disturbance.data(), next.data());
+  const std::vector<double> noise = draw_noise(state);
+  for (std::size_t i = 0; i < state_dims_; ++i) next[i] += noise[i];
+  return next;
+}
+
+std::vector<double> PlantModel::draw_noise(const std::vector<double>& state) {
+  const std::size_t n = state_dims_;
   std::vector<double> standard(n);
   const bool uniform = config_.noise.distribution == amytiss::Distribution::Uniform;
   for (auto& z : standard)
     z = uniform ? std::uniform_real_distribution<double>(-1.0, 1.0)(random_)
                 : std::normal_distribution<double>(0.0, 1.0)(random_);
+  std::vector<double> noise(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
-    double noise = 0.0;
-    for (std::size_t k = 0; k <= i; ++k) noise += noise_factor_[i * n + k] * standard[k];
-    if (config_.noise.type == amytiss::NoiseType::Multiplicative) noise *= std::abs(state[i]);
-    next[i] += noise;
+    for (std::size_t k = 0; k <= i; ++k) noise[i] += noise_factor_[i * n + k] * standard[k];
+    if (config_.noise.type == amytiss::NoiseType::Multiplicative) noise[i] *= std::abs(state[i]);
   }
-  return next;
+  return noise;
 }
 
 StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state) {

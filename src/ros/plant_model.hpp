@@ -1,6 +1,7 @@
 #pragma once
 // A concrete stochastic plant for closed-loop simulation: x+ = f(x, u, w) + noise (additive) or
 // f(x, u, w) + noise * |x| (multiplicative, per component), with its own seeded random numbers.
+// The noise is drawn from the configuration's noise description in one place, draw_noise().
 // The disturbance w, when the configuration has one, is drawn uniformly from its box each step
 // (the synthesis assumed the worst case, so a random one can only do better).
 #include <cstdint>
@@ -18,7 +19,9 @@ namespace amytiss_ros {
 
 class PlantModel {
  public:
-  /// Throws ConfigError (from make_dynamics, or for a covariance that has no Cholesky factor).
+  /// `config` passed validate() when its policy was computed. Throws ConfigError (from
+  /// make_dynamics, or key "noise.distribution" for a law it cannot draw yet: it draws normal
+  /// and uniform noise).
   PlantModel(const amytiss::Config& config, std::uint64_t seed);
 
   std::size_t state_dims() const { return state_dims_; }
@@ -26,6 +29,10 @@ class PlantModel {
   std::vector<double> step(const std::vector<double>& state, const std::vector<double>& input);
 
  private:
+  /// One draw of the noise added to f(x, u, w) at `state` (state units; multiplicative noise
+  /// already scaled by |x|).
+  std::vector<double> draw_noise(const std::vector<double>& state);
+
   amytiss::Config config_;
   std::unique_ptr<amytiss::Dynamics> dynamics_;
   std::size_t state_dims_ = 0;

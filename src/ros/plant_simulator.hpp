@@ -27,6 +27,8 @@
 #include <amytiss/PolicyStatus.h>
 #include <ros/ros.h>
 
+#include "plant_model.hpp"
+
 namespace amytiss_ros {
 
 class PlantSimulatorNode {
@@ -37,12 +39,40 @@ class PlantSimulatorNode {
   int run();
 
  private:
+  /// The private parameters (see above).
+  struct Settings {
+    std::vector<double> initial_state;
+    int episodes = 20, seed = 1;
+    double command_timeout_s = 5.0, policy_timeout_s = 600.0, playback_period_s = 0.0;
+    std::string output_dir, plot_script, python, scene_file;
+    bool exit_when_done = true;
+  };
+  struct Simulation;  // the policy, its configuration and the plant of one run()
+
+  Settings read_settings() const;
   void on_status(const amytiss::PolicyStatus::ConstPtr& status);
   void on_command(const amytiss::InputCommand::ConstPtr& command);
+  /// The first ready status within the timeout, or null.
+  amytiss::PolicyStatus::ConstPtr wait_for_policy(double timeout_s);
+  /// Whether the policy server subscribed to state and publishes command within the timeout.
+  bool wait_for_server(double timeout_s);
+  /// All episodes; their trajectories into the CSV file `csv_path`. Fills episodes, successes,
+  /// outcomes and csv_file of the summary.
+  amytiss::EpisodeSummary run_episodes(Simulation& simulation, const std::string& csv_path);
+  /// One episode from the initial state; its CSV rows (without the success column) into `rows`.
+  EpisodeOutcome run_episode(int episode, Simulation& simulation, std::vector<std::string>& rows);
+  /// The server's command for `state` at `step`; a "no policy yet" answer is asked again until
+  /// policy_timeout_s. Null when the server did not answer within command_timeout_s.
+  amytiss::InputCommand::ConstPtr request_input(const std::vector<double>& state, unsigned step);
+  /// Runs the plot script; on success the picture paths go into `summary`.
+  void draw_pictures(const Simulation& simulation, const std::string& csv_path, const std::string& base,
+                     amytiss::EpisodeSummary& summary) const;
 
   ros::NodeHandle public_handle_, private_handle_;
   ros::Publisher state_publisher_, summary_publisher_, car_publisher_;
   ros::Subscriber status_subscriber_, command_subscriber_;
+  Settings settings_;
+  ros::Time last_stamp_;  // of the last published state: each state gets a later stamp
 
   std::mutex mutex_;
   std::condition_variable changed_;

@@ -33,10 +33,10 @@ std::string default_policy_path(const std::string& config_name) {
 SynthesizerNode::SynthesizerNode(ros::NodeHandle public_handle, ros::NodeHandle private_handle)
     : public_handle_(public_handle),
       private_handle_(private_handle),
+      status_publisher_(public_handle_.advertise<amytiss::PolicyStatus>("status", 1, /*latch=*/true)),
       diagnostics_(public_handle, private_handle),
       action_server_(public_handle, "synthesize",
                      [this](const amytiss::SynthesizeGoalConstPtr& goal) { execute_goal(goal); }, false) {
-  status_publisher_ = public_handle_.advertise<amytiss::PolicyStatus>("status", 1, /*latch=*/true);
   update_status([](amytiss::PolicyStatus& status) {
     status.phase = amytiss::PolicyStatus::PHASE_IDLE;
     status.remaining_s = -1;
@@ -73,10 +73,7 @@ void SynthesizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& diag
   diagnostic.add("syntheses run", status_.syntheses_run);
 }
 
-SynthesizerNode::~SynthesizerNode() {
-  cancel_startup_job_ = true;
-  if (startup_thread_.joinable()) startup_thread_.join();
-}
+SynthesizerNode::~SynthesizerNode() { shutdown(); }
 
 void SynthesizerNode::start() {
   action_server_.start();
@@ -85,9 +82,23 @@ void SynthesizerNode::start() {
   if (!synthesize_on_start) return;
   startup_thread_ = std::thread([this] {
     std::lock_guard<std::mutex> job_lock(job_mutex_);
+    if (stopping_) return;
     run_from_source([this] { return read_parameters(); }, /*force=*/false,
-                    [this] { return cancel_startup_job_.load() || !ros::ok(); },
+                    [this] { return stopping_.load() || cancel_startup_job_.load() || !ros::ok(); },
                     [](const amytiss::Progress&) {});
+  });
+}
+
+void SynthesizerNode::shutdown() {
+  if (stopping_.exchange(true)) return;
+  heartbeat_timer_.stop();
+  // Joins the action thread: its goal, if any, sees stopping_ at its next progress report.
+  action_server_.shutdown();
+  if (startup_thread_.joinable()) startup_thread_.join();
+  update_status([](amytiss::PolicyStatus& status) {
+    status.synthesizing = false;
+    status.remaining_s = -1;
+    status.message = "synthesizer stopped";
   });
 }
 
@@ -124,11 +135,7 @@ SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<am
     Outcome outcome;
     outcome.message = std::string("invalid configuration: ") + error.what();
     ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
-    update_status([&](amytiss::PolicyStatus& status) {
-      status.synthesizing = false;
-      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
-      status.message = outcome.message;
-    });
+    report_stopped(amytiss::PolicyStatus::PHASE_ERROR, outcome.message);
     return outcome;
   }
   return run(config, force, cancelled, on_progress);
@@ -137,55 +144,51 @@ SynthesizerNode::Outcome SynthesizerNode::run_from_source(const std::function<am
 SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, bool force,
                                               const CancelCheck& cancelled, const ProgressSink& on_progress) {
   Outcome outcome;
-  const std::string hash = amytiss::config_hash(config);
-  const std::string device = amytiss::to_string(config.compute.device);
   try {
     outcome.policy_file = policy_path_for(config);
   } catch (const std::exception& error) {
     outcome.message = std::string("bad policy_file parameter: ") + error.what();
     ROS_ERROR("%s", outcome.message.c_str());
-    update_status([&](amytiss::PolicyStatus& status) {
-      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
-      status.message = outcome.message;
-    });
+    report_stopped(amytiss::PolicyStatus::PHASE_ERROR, outcome.message);
     return outcome;
   }
-  const auto announce = [&](const amytiss::Policy& policy, const std::string& phase) {
-    update_status([&](amytiss::PolicyStatus& status) {
-      status.ready = true;
-      status.synthesizing = false;
-      status.percent = 100.0;
-      status.phase = phase;
-      status.device = policy.computed_by;
-      status.remaining_s = 0.0;
-      status.message = outcome.message;
-      status.config_name = config.name;
-      status.config_hash = hash;
-      status.policy_file = outcome.policy_file;
-      status.horizon = policy.horizon;
-      status.run_id = policy.run_id;
-      status.generation += 1;
-      if (phase == amytiss::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
-    });
-  };
-
-  if (!force && std::filesystem::exists(outcome.policy_file)) {
-    try {
-      const amytiss::LoadedPolicy loaded = amytiss::read_policy_file_for(outcome.policy_file, config);
-      outcome.success = true;
-      outcome.reused = true;
-      outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name +
-                        "' unchanged, hash " + hash + "); nothing to synthesize";
-      ROS_INFO("%s", outcome.message.c_str());
-      announce(loaded.policy, amytiss::PolicyStatus::PHASE_REUSED);
-      return outcome;
-    } catch (const amytiss::PolicyFileError& error) {
-      ROS_WARN("not reusing %s: %s; computing it again", outcome.policy_file.c_str(), error.what());
-    }
+  if (!force && reuse_existing(config, outcome)) return outcome;
+  try {
+    synthesize_and_write(config, cancelled, on_progress, outcome);
+  } catch (const amytiss::Cancelled&) {
+    outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
+    ROS_WARN("%s", outcome.message.c_str());
+    report_stopped(amytiss::PolicyStatus::PHASE_CANCELLED, outcome.message);
+  } catch (const std::exception& error) {
+    outcome.message = "synthesis of '" + config.name + "' failed: " + error.what();
+    ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
+    report_stopped(amytiss::PolicyStatus::PHASE_ERROR, outcome.message);
   }
+  return outcome;
+}
 
-  ROS_INFO("synthesizing '%s' (hash %s, horizon %u) on device %s -> %s", config.name.c_str(), hash.c_str(),
-           config.spec.horizon, device.c_str(), outcome.policy_file.c_str());
+bool SynthesizerNode::reuse_existing(const amytiss::Config& config, Outcome& outcome) {
+  if (!std::filesystem::exists(outcome.policy_file)) return false;
+  try {
+    const amytiss::LoadedPolicy loaded = amytiss::read_policy_file_for(outcome.policy_file, config);
+    outcome.success = true;
+    outcome.reused = true;
+    outcome.message = "reusing " + outcome.policy_file + " (configuration '" + config.name + "' unchanged, hash " +
+                      amytiss::config_hash(config) + "); nothing to synthesize";
+    ROS_INFO("%s", outcome.message.c_str());
+    announce(config, loaded.policy, outcome, amytiss::PolicyStatus::PHASE_REUSED);
+    return true;
+  } catch (const amytiss::PolicyFileError& error) {
+    ROS_WARN("not reusing %s: %s; computing it again", outcome.policy_file.c_str(), error.what());
+    return false;
+  }
+}
+
+void SynthesizerNode::synthesize_and_write(const amytiss::Config& config, const CancelCheck& cancelled,
+                                           const ProgressSink& on_progress, Outcome& outcome) {
+  const std::string device = amytiss::to_string(config.compute.device);
+  ROS_INFO("synthesizing '%s' (hash %s, horizon %u) on device %s -> %s", config.name.c_str(),
+           amytiss::config_hash(config).c_str(), config.spec.horizon, device.c_str(), outcome.policy_file.c_str());
   update_status([&](amytiss::PolicyStatus& status) {
     status.synthesizing = true;
     status.percent = 0.0;
@@ -195,72 +198,91 @@ SynthesizerNode::Outcome SynthesizerNode::run(const amytiss::Config& config, boo
     status.message = "synthesizing '" + config.name + "' on " + device;
   });
   const auto started = std::chrono::steady_clock::now();
-  try {
-    const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config);
-    amytiss::SynthesisOptions options;
-    options.compute = config.compute;
-    options.progress = [&](const amytiss::Progress& progress) {
-      const std::string text = describe_progress(progress);
-      ROS_INFO("%s", text.c_str());
-      update_status([&](amytiss::PolicyStatus& status) {
-        status.synthesizing = true;
-        status.percent = progress.percent();
-        status.phase = amytiss::to_string(progress.phase);
-        status.device = progress.device;
-        status.remaining_s = progress.remaining_s;
-        status.message = text;
-      });
-      on_progress(progress);
-      return !cancelled();
-    };
-    amytiss::SynthesisReport report;
-    const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
-    for (const auto& note : report.notes) {
-      if (note.severity == amytiss::NoteSeverity::Warning)
-        ROS_WARN("%s", note.text.c_str());
-      else
-        ROS_INFO("%s", note.text.c_str());
-    }
-    if (cancelled()) throw amytiss::Cancelled();
-    std::filesystem::create_directories(std::filesystem::path(outcome.policy_file).parent_path());
-    amytiss::write_policy_file(outcome.policy_file, policy, config);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const amytiss::ValueSummary summary = amytiss::summarize_initial_values(policy);
-    char text[512];
-    std::snprintf(text, sizeof text,
-                  "new policy '%s' synthesized in %.2f s on %s: V_0 over free cells min %.4f mean %.4f "
-                  "max %.4f; written to %s",
-                  config.name.c_str(), seconds, policy.computed_by.c_str(), summary.min, summary.mean,
-                  summary.max, outcome.policy_file.c_str());
-    outcome.success = true;
-    outcome.message = text;
-    ROS_INFO("%s", text);
-    announce(policy, amytiss::PolicyStatus::PHASE_DONE);
-  } catch (const amytiss::Cancelled&) {
-    outcome.message = "synthesis of '" + config.name + "' cancelled; still serving the last good policy";
-    ROS_WARN("%s", outcome.message.c_str());
+  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config);
+  amytiss::SynthesisOptions options;
+  options.compute = config.compute;
+  options.progress = [&](const amytiss::Progress& progress) {
+    const std::string text = describe_progress(progress);
+    ROS_INFO("%s", text.c_str());
     update_status([&](amytiss::PolicyStatus& status) {
-      status.synthesizing = false;
-      status.phase = amytiss::PolicyStatus::PHASE_CANCELLED;
-      status.remaining_s = -1;
-      status.message = outcome.message;
+      status.synthesizing = true;
+      status.percent = progress.percent();
+      status.phase = amytiss::to_string(progress.phase);
+      status.device = progress.device;
+      status.remaining_s = progress.remaining_s;
+      status.message = text;
     });
-  } catch (const std::exception& error) {
-    outcome.message = "synthesis of '" + config.name + "' failed: " + error.what();
-    ROS_ERROR("%s (still serving the last good policy, if any)", outcome.message.c_str());
-    update_status([&](amytiss::PolicyStatus& status) {
-      status.synthesizing = false;
-      status.phase = amytiss::PolicyStatus::PHASE_ERROR;
-      status.remaining_s = -1;
-      status.message = outcome.message;
-    });
+    on_progress(progress);
+    return !cancelled();
+  };
+  amytiss::SynthesisReport report;
+  const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
+  for (const auto& note : report.notes) {
+    if (note.severity == amytiss::NoteSeverity::Warning)
+      ROS_WARN("%s", note.text.c_str());
+    else
+      ROS_INFO("%s", note.text.c_str());
   }
-  return outcome;
+  if (cancelled()) throw amytiss::Cancelled();
+  // Not cancellable from here on: the file is written whole to a temporary and renamed.
+  update_status([&](amytiss::PolicyStatus& status) { status.message = "writing " + outcome.policy_file; });
+  std::filesystem::create_directories(std::filesystem::path(outcome.policy_file).parent_path());
+  amytiss::write_policy_file(outcome.policy_file, policy, config);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const amytiss::ValueSummary summary = amytiss::summarize_initial_values(policy);
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "new policy '%s' synthesized in %.2f s on %s: V_0 over free cells min %.4f mean %.4f "
+                "max %.4f; written to %s",
+                config.name.c_str(), seconds, policy.computed_by.c_str(), summary.min, summary.mean, summary.max,
+                outcome.policy_file.c_str());
+  outcome.success = true;
+  outcome.message = text;
+  ROS_INFO("%s", text);
+  announce(config, policy, outcome, amytiss::PolicyStatus::PHASE_DONE);
+}
+
+void SynthesizerNode::announce(const amytiss::Config& config, const amytiss::Policy& policy, const Outcome& outcome,
+                               const std::string& phase) {
+  update_status([&](amytiss::PolicyStatus& status) {
+    status.ready = true;
+    status.synthesizing = false;
+    status.percent = 100.0;
+    status.phase = phase;
+    status.device = policy.computed_by;
+    status.remaining_s = 0.0;
+    status.message = outcome.message;
+    status.config_name = config.name;
+    status.config_hash = amytiss::config_hash(config);
+    status.policy_file = outcome.policy_file;
+    status.horizon = policy.horizon;
+    status.run_id = policy.run_id;
+    status.generation += 1;
+    if (phase == amytiss::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;
+  });
+}
+
+void SynthesizerNode::report_stopped(const std::string& phase, const std::string& message) {
+  update_status([&](amytiss::PolicyStatus& status) {
+    status.synthesizing = false;
+    status.phase = phase;
+    status.remaining_s = -1;
+    status.message = message;
+  });
 }
 
 void SynthesizerNode::execute_goal(const amytiss::SynthesizeGoalConstPtr& goal) {
   cancel_startup_job_ = true;
   std::lock_guard<std::mutex> job_lock(job_mutex_);
+  if (stopping_) {
+    amytiss::SynthesizeResult result;
+    result.message = "the synthesizer is shutting down";
+    action_server_.setAborted(result, result.message);
+    return;
+  }
+  // Marks the start of this goal on the status stream, so that its outcome is told apart from
+  // an equal outcome of the previous goal.
+  update_status([](amytiss::PolicyStatus& status) { status.message = "new goal: reading its configuration"; });
   const auto read_config = [&]() {
     if (goal->config_yaml.empty()) return read_parameters();
     std::string device;
@@ -269,7 +291,7 @@ void SynthesizerNode::execute_goal(const amytiss::SynthesizeGoalConstPtr& goal) 
   };
   const Outcome outcome = run_from_source(
       read_config, goal->force,
-      [this] { return action_server_.isPreemptRequested() || !ros::ok(); },
+      [this] { return stopping_.load() || action_server_.isPreemptRequested() || !ros::ok(); },
       [this](const amytiss::Progress& progress) { action_server_.publishFeedback(feedback_from_progress(progress)); });
   amytiss::SynthesizeResult result;
   result.success = outcome.success;

@@ -24,6 +24,13 @@ noise: {type: additive, distribution: normal, covariance: [0.05, 0.05], truncati
 spec: {type: reach_avoid, horizon: 40, target: {lb: [3, 3], ub: [4.5, 4.5]}, avoid: {lb: [-1, -1], ub: [1, 1]}}
 )YAML";
 
+/// A goal's result and the status that reports it (the status topic and the action's result
+/// arrive in either order: the latest status right after the result may still be an older one).
+struct GoalOutcome {
+  amytiss::SynthesizeResult result;
+  amytiss::PolicyStatus status;
+};
+
 class SynthesizerAndServerTest : public ::testing::Test {
  protected:
 
@@ -51,6 +58,15 @@ class SynthesizerAndServerTest : public ::testing::Test {
     action_.sendGoal(goal);
     EXPECT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
     return *action_.getResult();
+  }
+  GoalOutcome run_goal_with_status(const amytiss::SynthesizeGoal& goal) {
+    const StatusMark before = status_.mark();
+    GoalOutcome outcome;
+    outcome.result = run_goal(goal);
+    const auto status = status_.wait_for_outcome(before, outcome.result.message, kPolicyWaitSeconds);
+    EXPECT_TRUE(status.has_value()) << "no status says: " << outcome.result.message.substr(0, 500);
+    if (status) outcome.status = *status;
+    return outcome;
   }
 
   ros::NodeHandle handle_;

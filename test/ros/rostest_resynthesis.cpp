@@ -16,6 +16,7 @@ using amytiss_test::kActionWaitSeconds;
 using amytiss_test::kSlowConfig;
 using Client = actionlib::SimpleActionClient<amytiss::SynthesizeAction>;
 using ResynthesisTest = amytiss_test::SynthesizerAndServerTest;
+using amytiss_test::GoalOutcome;
 
 TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOnesReuseTheFile) {
   const amytiss::PolicyStatus before = status_.latest();
@@ -46,12 +47,11 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   target_lb[0] = 2.0;
   target_lb[1] = 2.0;
   ros::param::set(kSynthesizer + "/spec/target/lb", target_lb);
-  const amytiss::SynthesizeResult changed = run_goal(amytiss::SynthesizeGoal());
-  EXPECT_TRUE(changed.success) << changed.message;
-  EXPECT_FALSE(changed.reused);
-  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > before.generation; },
-                               amytiss_test::kPolicyWaitSeconds));
-  const amytiss::PolicyStatus after = status_.latest();
+  const GoalOutcome changed = run_goal_with_status(amytiss::SynthesizeGoal());
+  EXPECT_TRUE(changed.result.success) << changed.result.message;
+  EXPECT_FALSE(changed.result.reused);
+  const amytiss::PolicyStatus after = changed.status;
+  EXPECT_EQ(after.generation, before.generation + 1);
   EXPECT_EQ(after.syntheses_run, before.syntheses_run + 1);
   EXPECT_NE(after.config_hash, before.config_hash);
   EXPECT_EQ(after.horizon, 9u);
@@ -76,25 +76,27 @@ TEST_F(ResynthesisTest, ChangedParametersSwapThePolicyWhileServingAndUnchangedOn
   EXPECT_GT(answered.load(), 0);
 
   // Unchanged parameters: the file is reused, nothing is computed.
-  const amytiss::SynthesizeResult unchanged = run_goal(amytiss::SynthesizeGoal());
-  EXPECT_TRUE(unchanged.success) << unchanged.message;
-  EXPECT_TRUE(unchanged.reused);
-  EXPECT_NE(unchanged.message.find("reusing"), std::string::npos) << unchanged.message;
-  ASSERT_TRUE(status_.wait_for([&](const amytiss::PolicyStatus& s) { return s.generation > after.generation; },
-                               amytiss_test::kPolicyWaitSeconds));
-  EXPECT_EQ(status_.latest().syntheses_run, after.syntheses_run);
-  EXPECT_EQ(status_.latest().phase, "reused");
+  const GoalOutcome unchanged = run_goal_with_status(amytiss::SynthesizeGoal());
+  EXPECT_TRUE(unchanged.result.success) << unchanged.result.message;
+  EXPECT_TRUE(unchanged.result.reused);
+  EXPECT_NE(unchanged.result.message.find("reusing"), std::string::npos) << unchanged.result.message;
+  EXPECT_EQ(unchanged.status.generation, after.generation + 1);
+  EXPECT_EQ(unchanged.status.syntheses_run, after.syntheses_run);
+  EXPECT_EQ(unchanged.status.phase, "reused");
 
   // force: computed again although the file is valid.
   amytiss::SynthesizeGoal forced;
   forced.force = true;
-  const amytiss::SynthesizeResult recomputed = run_goal(forced);
-  EXPECT_TRUE(recomputed.success);
-  EXPECT_FALSE(recomputed.reused);
+  const GoalOutcome recomputed = run_goal_with_status(forced);
+  EXPECT_TRUE(recomputed.result.success);
+  EXPECT_FALSE(recomputed.result.reused);
+  EXPECT_EQ(recomputed.status.syntheses_run, after.syntheses_run + 1);
+  EXPECT_NE(recomputed.status.run_id, after.run_id);
 }
 
 TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
   const amytiss::PolicyStatus before = status_.latest();
+  const amytiss_test::StatusMark mark = status_.mark();
   std::atomic<int> feedbacks{0};
   amytiss::SynthesizeGoal goal;
   goal.config_yaml = kSlowConfig;
@@ -108,8 +110,11 @@ TEST_F(ResynthesisTest, ARunningSynthesisCanBeCancelledAndTheOldPolicyStays) {
   ASSERT_TRUE(action_.waitForResult(ros::Duration(kActionWaitSeconds)));
   EXPECT_EQ(action_.getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   EXPECT_FALSE(action_.getResult()->success);
-  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "cancelled"; }, 10.0));
-  const amytiss::PolicyStatus after = status_.latest();
+  const auto cancelled = status_.wait_for_outcome(mark, action_.getResult()->message, amytiss_test::kPolicyWaitSeconds);
+  ASSERT_TRUE(cancelled.has_value()) << action_.getResult()->message;
+  const amytiss::PolicyStatus after = *cancelled;
+  EXPECT_EQ(after.phase, "cancelled");
+  EXPECT_FALSE(after.synthesizing);
   EXPECT_TRUE(after.ready);
   EXPECT_EQ(after.generation, before.generation);
   EXPECT_EQ(after.config_hash, before.config_hash);
@@ -121,13 +126,13 @@ TEST_F(ResynthesisTest, ABadConfigurationIsReportedAndTheOldPolicyStays) {
   amytiss::SynthesizeGoal goal;
   goal.config_yaml = std::string(kSlowConfig) + "\n";
   goal.config_yaml.replace(goal.config_yaml.find("horizon: 40"), 11, "horizon: 0");
-  const amytiss::SynthesizeResult result = run_goal(goal);
-  EXPECT_FALSE(result.success);
-  EXPECT_NE(result.message.find("horizon"), std::string::npos) << result.message;
-  ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.phase == "error"; }, 10.0));
-  EXPECT_NE(status_.latest().message.find("horizon"), std::string::npos);
-  EXPECT_TRUE(status_.latest().ready);
-  EXPECT_EQ(status_.latest().generation, before.generation);
+  const GoalOutcome refused = run_goal_with_status(goal);
+  EXPECT_FALSE(refused.result.success);
+  EXPECT_NE(refused.result.message.find("horizon"), std::string::npos) << refused.result.message;
+  EXPECT_EQ(refused.status.phase, "error");
+  EXPECT_NE(refused.status.message.find("horizon"), std::string::npos);
+  EXPECT_TRUE(refused.status.ready);
+  EXPECT_EQ(refused.status.generation, before.generation);
   EXPECT_TRUE(call({-4.0, -4.0}, 0).success);
 }
 
