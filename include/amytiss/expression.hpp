@@ -35,6 +35,7 @@ constexpr std::size_t kMaxExpressionNodes = 10000;   // numbers, variables, oper
 std::string expression_excerpt(const std::string& text);
 
 struct ExpressionNode;  // defined in the .cpp
+struct ExpressionStep;  // expression_step.hpp
 
 /// Which components an expression reads: sorted, distinct indices of x, u and w.
 struct VariableUse {
@@ -67,6 +68,9 @@ class Expression {
   /// The variables that occur in the expression (after constant substitution). The value depends
   /// on no other component.
   VariableUse variables() const;
+
+  /// The parsed tree in postfix order (expression_step.hpp), chains unrolled left to right.
+  std::vector<ExpressionStep> postfix() const;
 
  private:
   std::shared_ptr<const ExpressionNode> root_;

@@ -32,6 +32,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "amytiss/config.hpp"
@@ -88,6 +89,15 @@ class NoiseModel {
   /// Centre offset of the window per dimension (state units): nearest_i(mu + offset_i) is its
   /// middle cell. 0 except for additive exponential/beta/custom noise with an asymmetric kept interval.
   const std::vector<double>& window_offset() const { return window_offset_; }
+
+  /// The law of Z_dim for exponential, beta and custom noise (noise = scale * Z, model/noise_laws.hpp);
+  /// nullptr for normal and uniform noise.
+  const detail::UnitLaw* unit_law(std::size_t dim) const { return laws_.empty() ? nullptr : laws_[dim].get(); }
+  /// Support [lo, hi] of the unit law Z_i of dimension `dim` (noise_i = scale(i, x) * Z_i, before
+  /// truncation): normal (-inf, inf), uniform [-1, 1], exponential [shift, inf), beta and custom
+  /// their `support`. A separable row keeps all its mass exactly when this interval, scaled and
+  /// moved to the post mean, lies inside its kept cells.
+  std::pair<double, double> unit_support(std::size_t dim) const;
 
   /// Mass of [lo, hi] under the 1-d law of dimension dim with the given mean and scale (a scale of
   /// 0 is a point mass: 1 when lo <= mean < hi). Exact (erfc), double precision.

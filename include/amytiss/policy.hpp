@@ -32,6 +32,9 @@ struct Policy {
   std::vector<double> upper_values;
   unsigned iterations = 0;  ///< interval iterations done (stationary only)
   double gap = 0;           ///< max over cells of upper - lower (stationary only)
+  /// Stationary only: whether `gap` reached the specification's tolerance. False: the bounds
+  /// are sound but further apart than asked (the synthesis also said so in a Warning note).
+  bool converged = true;
   /// What computed it (device name or "reference") and the configuration's hash.
   std::string computed_by;
   std::string config_hash;

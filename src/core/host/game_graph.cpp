@@ -3,8 +3,25 @@
 
 #include <algorithm>
 #include <cassert>
+#include <utility>
 
 namespace amytiss::detail {
+
+namespace {
+
+// Whether the whole law of one dimension (the unit support [lo, hi] scaled by `scale` around
+// `mean`, or the point `mean` when the scale is 0) falls in the cells first..last: decided from the
+// support's ends against the same cell faces the masses use, not from a sum of masses (laws whose
+// masses sum to 1 - 1e-16 in double keep their whole mass all the same).
+bool support_kept(const Grid& states, std::size_t dim, std::int64_t first, std::int64_t last, double mean,
+                  double scale, std::pair<double, double> unit_support) {
+  const double lo = states.lb()[dim] + (double(first) - 0.5) * states.eta()[dim];
+  const double hi = states.lb()[dim] + (double(last) + 0.5) * states.eta()[dim];
+  if (scale == 0.0) return lo <= mean && mean < hi;
+  return mean + scale * unit_support.first >= lo && mean + scale * unit_support.second <= hi;
+}
+
+}  // namespace
 
 GameSupports::GameSupports(const Abstraction& a)
     : a_(a), dims_(a.states.dims()), inputs_(a.inputs.size()), disturbances_(a.disturbances.size()) {
@@ -28,7 +45,8 @@ GameSupports::GameSupports(const Abstraction& a)
         if (!noise.window(a.states, mean.data(), first.data(), last.data())) continue;
         std::uint32_t* box = &boxes_[r * 2 * dims_];
         bool empty = false;
-        double kept = 1.0;
+        // A full covariance's rows always lose their tails.
+        bool kept = noise.separable();
         for (std::size_t d = 0; d < dims_ && !empty; ++d) {
           if (!noise.separable()) {
             box[2 * d] = std::uint32_t(first[d]);
@@ -36,24 +54,24 @@ GameSupports::GameSupports(const Abstraction& a)
             continue;
           }
           masses.resize(std::size_t(last[d] - first[d] + 1));
-          noise.cell_masses(d, first[d], last[d], mean[d], noise.scale(d, x.data()), masses.data());
+          const double scale = noise.scale(d, x.data());
+          noise.cell_masses(d, first[d], last[d], mean[d], scale, masses.data());
           std::int64_t lo = -1, hi = -1;
-          double sum = 0.0;
           for (std::size_t k = 0; k < masses.size(); ++k)
             if (masses[k] > 0) {
               if (lo < 0) lo = std::int64_t(k);
               hi = std::int64_t(k);
-              sum += masses[k];
             }
-          if (lo < 0) empty = true;
+          if (lo < 0) {
+            empty = true;
+            break;
+          }
           box[2 * d] = std::uint32_t(first[d] + lo);
           box[2 * d + 1] = std::uint32_t(first[d] + hi);
-          kept *= sum;
+          kept = kept && support_kept(a.states, d, first[d] + lo, first[d] + hi, mean[d], scale, noise.unit_support(d));
         }
         empty_[r] = empty;
-        // A full covariance's rows always lose their tails; a separable row leaks when its kept
-        // mass falls short of 1 in double (the conservative side for every use of the flag).
-        leaks_[r] = empty || !noise.separable() || !(kept >= 1.0);
+        leaks_[r] = empty || !kept;
       }
     }
   }

@@ -16,7 +16,8 @@ class GameSupports {
  public:
   /// Computes every row's support: per dimension the first and last cell of non-zero mass (the
   /// support of a separable row is that box; for a full covariance, its window), and whether the
-  /// row's masses sum to less than 1 (mass leaves the grid or is cut: the row "leaks").
+  /// row loses mass (off the grid or to the truncation: the row "leaks"), decided from the noise
+  /// law's support against the box's cells (NoiseModel::unit_support), never from a sum of masses.
   explicit GameSupports(const Abstraction& abstraction);
 
   std::size_t free_cells() const { return free_list_.size(); }

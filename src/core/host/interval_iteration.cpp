@@ -25,6 +25,15 @@ constexpr unsigned kCorrectionPeriod = 8;
 constexpr double kOptimalSlack = 1e-12;
 // The iteration aims at half the tolerance, leaving the other half to the certified policy.
 constexpr double kIterationShareOfTolerance = 0.5;
+// Optimistic upper bounds (reachability): first tried at this iteration, then at twice the
+// iterations after each failed try, once the lower bound moved by at most kSettledShare of the
+// iteration's target in the last iteration; the guess lies kGuessShare of the target above it.
+constexpr unsigned kFirstOptimisticTry = 256;
+constexpr double kSettledShare = 0.01;
+constexpr double kGuessShare = 0.5;
+// Relative error allowed for the host's sums of non-negative mass * value terms (the masses'
+// own rounding and the summation's) when a guess is verified.
+constexpr double kMassRelativeError = 1e-12;
 
 std::string number(double value) {
   char text[32];
@@ -47,6 +56,50 @@ struct Iteration {
   std::vector<double> lower, upper;
   std::vector<std::uint32_t> ec_input;     // safety: the input that keeps the play in its component
   std::vector<double> ec_value;            // the value the correction gave that cell (-1: none)
+
+  // Reachability: U' = min(U, L + epsilon) bounds the value from above when T(U') <= U' (the
+  // value is the least fixed point of T, below every pre-fixed point). Checked row by row on the
+  // host as sum_x' T(x'|row) (U'(x') - U'(x)) - (mass off the grid) U'(x) <= 0, the positive and
+  // the negative terms summed apart, so that rows whose mass stays among cells of the same guess
+  // (near end components, where plain iteration crawls) pass exactly; for every input some
+  // disturbance's row must pass.
+  bool optimistic_upper(double epsilon) {
+    const std::size_t n = a.states.size();
+    std::vector<double> guess(n), above(n, 0.0), below(n, 0.0), ones(n, 1.0);
+    for (std::size_t x = 0; x < n; ++x) guess[x] = std::min(upper[x], lower[x] + epsilon);
+    const double absolute_error = a.noise->quadrature_error_bound();
+    auto row_passes = [&](std::size_t rank, std::size_t u, std::size_t w) {
+      const std::size_t r = supports.row(rank, u, w), x = supports.free_cell(rank);
+      if (supports.empty(r)) return true;  // all its mass leaves the grid
+      bool any_above = false;
+      supports.for_each_cell(r, [&](std::size_t cell) {
+        above[cell] = std::max(0.0, guess[cell] - guess[x]);
+        below[cell] = std::max(0.0, guess[x] - guess[cell]);
+        any_above = any_above || above[cell] > 0;
+      });
+      bool passes = !any_above;
+      if (!passes) {
+        const double lost = std::max(0.0, 1.0 - host.expected(x, u, w, ones.data()) - kMassRelativeError);
+        const double rise = host.expected(x, u, w, above.data());
+        const double fall = host.expected(x, u, w, below.data()) + lost * guess[x];
+        // Each of the three sums may be off by the row's absolute mass error.
+        const double row_error = absolute_error + a.noise->box_mass_tolerance() * double(supports.box_cells(r));
+        passes = rise * (1 + kMassRelativeError) + 3 * row_error <= fall * (1 - kMassRelativeError);
+      }
+      supports.for_each_cell(r, [&](std::size_t cell) { above[cell] = below[cell] = 0.0; });
+      return passes;
+    };
+    for (std::size_t rank = 0; rank < supports.free_cells(); ++rank) {
+      if (guess[supports.free_cell(rank)] >= 1.0) continue;  // T never exceeds 1
+      for (std::size_t u = 0; u < supports.inputs(); ++u) {
+        bool passes = false;
+        for (std::size_t w = 0; w < supports.disturbances() && !passes; ++w) passes = row_passes(rank, u, w);
+        if (!passes) return false;
+      }
+    }
+    for (std::size_t x = 0; x < n; ++x) upper[x] = std::min(upper[x], guess[x]);
+    return true;
+  }
 
   // Reachability: an end component the adversary can keep the play in (using its choices that
   // are optimal for the lower bound) is worth at most the controller's best way out.
@@ -190,14 +243,21 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
   unsigned iterations = 0;
   double gap = largest_gap(it.lower, it.upper);
   std::vector<std::uint32_t> lower_input(n, 0);
-  while (gap > kIterationShareOfTolerance * a.tolerance && iterations < kMaxIterations) {
+  const double target = kIterationShareOfTolerance * a.tolerance;
+  unsigned next_optimistic_try = kFirstOptimisticTry, optimistic_at = 0;
+  while (gap > target && iterations < kMaxIterations) {
     bool moved = false;
+    double lower_change = 0;
     step.apply(it.lower.data(), next.data(), lower_input.data());
     for (std::size_t x = 0; x < n; ++x) {
       // The input changes only when the lower bound grows by more than the step's rounding: an
       // input that is merely as good (a way to stay in an end component) makes no progress.
       if (next[x] > it.lower[x] + step.resolution()) policy_input[x] = lower_input[x];
-      if (next[x] > it.lower[x]) it.lower[x] = next[x], moved = true;
+      if (next[x] > it.lower[x]) {
+        lower_change = std::max(lower_change, next[x] - it.lower[x]);
+        it.lower[x] = next[x];
+        moved = true;
+      }
     }
     step.apply(it.upper.data(), next.data(), upper_input.data());
     for (std::size_t x = 0; x < n; ++x)
@@ -205,6 +265,10 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
     ++iterations;
     if (component_cells > 0 && iterations % kCorrectionPeriod == 0)
       moved |= reach ? it.deflate_upper() : it.inflate_lower();
+    if (reach && iterations >= next_optimistic_try && lower_change <= kSettledShare * target) {
+      next_optimistic_try = 2 * iterations;
+      if (it.optimistic_upper(kGuessShare * target)) optimistic_at = iterations, moved = true;
+    }
     gap = largest_gap(it.lower, it.upper);
     if (run.on_iteration) run.on_iteration(iterations, gap);
     // Neither sequence moves (and the corrections found nothing): the gap cannot close.
@@ -212,6 +276,10 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
   }
   report.phases.push_back({"interval iteration (" + std::to_string(iterations) + " iterations)",
                            seconds_since(phase_start), 0, step.multiply_adds() * 2.0 * iterations});
+  if (optimistic_at > 0)
+    report.notes.push_back({NoteSeverity::Info, NoteKind::Convergence,
+                            "unbounded: an optimistic upper bound (the lower bound + " + number(kGuessShare * target) +
+                                ") was verified (T(U) <= U) at iteration " + std::to_string(optimistic_at)});
 
   // --- the stationary policy: greedy for the lower bound, the sure input where safety is sure,
   // the component's input where a correction set the lower bound; its value from below.
@@ -255,6 +323,7 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
   policy.upper_values = it.upper;
   policy.iterations = iterations;
   policy.gap = certified_gap;
+  policy.converged = certified_gap <= a.tolerance;
   return policy;
 }
 

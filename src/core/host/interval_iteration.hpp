@@ -19,10 +19,11 @@ struct UnboundedRun {
 };
 
 /// Iterates `step` (any engine's) on both sequences until upper - lower <= a.tolerance on every
-/// cell, or until neither moves any more, or kMaxIterations; then certifies the stationary policy
-/// with `host` (T_sigma from below). The returned policy holds the certified lower bound, the
-/// upper bound, the iterations and the final gap; report gets the phases and, when the gap is
-/// above the tolerance, a Warning note that says so.
+/// cell, or until neither moves any more, or kMaxIterations (reachability: with optimistic upper
+/// bounds verified on `host`); then certifies the stationary policy with `host` (T_sigma from
+/// below). The returned policy holds the certified lower bound, the upper bound, the iterations,
+/// the final gap and whether it reached the tolerance (`converged`); report gets the phases and,
+/// when the gap is above the tolerance, a Warning note that says so.
 Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& host, const UnboundedRun& run,
                        SynthesisReport& report);
 

@@ -70,7 +70,7 @@ struct FileAttributes {
   std::string config_hash, computed_by, run_id;
   std::uint64_t engine_version = 0, horizon = 0;
   std::string spec;
-  std::uint64_t stationary = 0, iterations = 0;  // unbounded specifications only
+  std::uint64_t stationary = 0, iterations = 0, converged = 0;  // unbounded specifications only
 };
 
 void add_attributes(ContentDigest& digest, const FileAttributes& attributes) {
@@ -86,6 +86,7 @@ void add_attributes(ContentDigest& digest, const FileAttributes& attributes) {
   if (attributes.stationary) {
     digest.add(attributes.stationary);
     digest.add(attributes.iterations);
+    digest.add(attributes.converged);
   }
 }
 
@@ -278,6 +279,7 @@ void write_contents(hid_t file, const Policy& policy, const Config& config, cons
   attributes.spec = to_string(config.spec.type);
   attributes.stationary = policy.stationary ? 1 : 0;
   attributes.iterations = policy.stationary ? policy.iterations : 0;
+  attributes.converged = policy.stationary && policy.converged ? 1 : 0;
   const std::string config_yaml = to_yaml(config);
 
   Writer writer(file);
@@ -292,6 +294,7 @@ void write_contents(hid_t file, const Policy& policy, const Config& config, cons
   if (attributes.stationary) {
     writer.unsigned_attribute("stationary", attributes.stationary);
     writer.unsigned_attribute("iterations", attributes.iterations);
+    writer.unsigned_attribute("converged", attributes.converged);
   }
   writer.string_attribute("content_digest", digest_of(attributes, config_yaml, policy));
   writer.string_dataset("/config", config_yaml);
@@ -575,6 +578,9 @@ Policy read_contents(hid_t file, const std::string& path, LoadedPolicy& loaded) 
     attributes.iterations = reader.unsigned_attribute("iterations");
     policy.stationary = true;
     policy.iterations = unsigned(std::min<std::uint64_t>(attributes.iterations, std::numeric_limits<unsigned>::max()));
+    attributes.converged = reader.unsigned_attribute("converged");
+    if (attributes.converged > 1) reader.fail("converged is " + std::to_string(attributes.converged) + ", expected 0 or 1");
+    policy.converged = attributes.converged == 1;
   }
   const std::string stored_digest = reader.string_attribute("content_digest");
   loaded.config_yaml = reader.string_dataset("/config");

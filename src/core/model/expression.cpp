@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "amytiss/errors.hpp"
+#include "amytiss/expression_step.hpp"
 
 namespace amytiss {
 
@@ -708,6 +709,44 @@ std::string expression_excerpt(const std::string& text) {
   constexpr std::size_t kShown = 60;
   if (text.size() <= kShown) return text;
   return text.substr(0, kShown) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
+}  // namespace amytiss
+
+namespace amytiss {
+
+namespace {
+void append_postfix(const ExpressionNode& node, std::vector<ExpressionStep>& steps) {
+  ExpressionStep step;
+  switch (node.kind) {
+    case NodeKind::Number: step.number = node.number; break;
+    case NodeKind::Variable:
+      step.kind = ExpressionStep::Kind::Variable;
+      step.space = "xuwz"[static_cast<int>(node.space)];
+      step.index = node.index;
+      break;
+    case NodeKind::Chain:
+      append_postfix(*node.children[0], steps);
+      for (std::size_t i = 1; i < node.children.size(); ++i) {
+        append_postfix(*node.children[i], steps);
+        steps.push_back({ExpressionStep::Kind::Operator, 0.0, 'x', 0, chain_symbol(node.chain_operations[i - 1]), 2});
+      }
+      return;
+    default:
+      for (const auto& child : node.children) append_postfix(*child, steps);
+      step.kind = ExpressionStep::Kind::Operator;
+      step.symbol = node.op;
+      step.arity = node.children.size();
+      break;
+  }
+  steps.push_back(step);
+}
+}  // namespace
+
+std::vector<ExpressionStep> Expression::postfix() const {
+  std::vector<ExpressionStep> steps;
+  append_postfix(*root_, steps);
+  return steps;
 }
 
 }  // namespace amytiss

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -336,6 +337,13 @@ std::size_t NoiseModel::window_cells() const {
     cells *= span;
   }
   return std::min(cells, grid_size_);
+}
+
+std::pair<double, double> NoiseModel::unit_support(std::size_t dim) const {
+  if (distribution_ == Distribution::Normal)
+    return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  if (laws_.empty()) return {-1.0, 1.0};  // uniform: the half-width is the scale
+  return {laws_[dim]->lo, laws_[dim]->hi};
 }
 
 double NoiseModel::interval_mass(std::size_t dim, double lo, double hi, double mean, double scale) const {
