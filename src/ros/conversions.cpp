@@ -65,13 +65,8 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamp
   name_policy(policy, command);
 }
 
-bool policy_converged(const amytiss::Policy& /*policy*/) {
-  // Wire to `return policy.converged;` when amytiss::Policy has the field.
-  return true;
-}
-
 std::string convergence_notice(const amytiss::Policy& policy) {
-  if (policy_converged(policy)) return "";
+  if (policy.converged) return "";
   char text[160];
   std::snprintf(text, sizeof text,
                 "policy did not converge: gap %.3g after %u iterations; probabilities are certified lower bounds",

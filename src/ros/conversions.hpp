@@ -33,12 +33,8 @@ void fill_get_input_response(const amytiss::Policy* policy, const std::vector<do
 void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
                         const std::string& server_notice, amytiss::InputCommand& command);
 
-/// Whether `policy` reached its specification's precision: an unbounded specification's interval
-/// iteration may stop before the gap between its bounds closes to the tolerance.
-/// To be wired: returns policy.converged once amytiss::Policy records it (until then true).
-bool policy_converged(const amytiss::Policy& policy);
-
-/// "" for a converged policy, otherwise the warning every answer of it carries: "policy did not
+/// "" for a converged policy (Policy::converged: an unbounded specification's interval iteration
+/// may stop before the gap between its bounds closes to the tolerance), otherwise the warning every answer of it carries: "policy did not
 /// converge: gap 3.2e-04 after 5000 iterations; probabilities are certified lower bounds".
 std::string convergence_notice(const amytiss::Policy& policy);
 

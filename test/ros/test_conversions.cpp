@@ -299,6 +299,17 @@ TEST(Markers, GridBoundsTargetAndAvoid) {
   EXPECT_EQ(markers.markers[2].header.frame_id, "map");
 }
 
+TEST(Convergence, APolicyWhoseGapDidNotCloseSaysSoWithTheGap) {
+  amytiss::Policy policy;
+  policy.stationary = true;
+  policy.iterations = 5000;
+  policy.gap = 3.2e-4;
+  EXPECT_EQ("", amytiss_ros::convergence_notice(policy));
+  policy.converged = false;
+  EXPECT_EQ("policy did not converge: gap 0.00032 after 5000 iterations; probabilities are certified lower bounds",
+            amytiss_ros::convergence_notice(policy));
+}
+
 TEST(Markers, AStoredBoxThatIsNotABoxIsRefusedNamingItsKey) {
   try {
     amytiss_ros::marked_sets_from_yaml("name: broken\nspec: {type: safety, horizon: 3, safe: {lb: 1}}\n");
