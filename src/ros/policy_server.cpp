@@ -117,8 +117,9 @@ void PolicyServerNode::refresh_notices() {
     notices->no_policy = refusal.empty() ? monitor_.no_policy_reason(now, publishers) : refusal;
     for (const std::string& part : {convergence_notice_, refusal, monitor_.serving_notice(served_, now, publishers)})
       if (!part.empty()) notices->serving += (notices->serving.empty() ? "" : "; ") + part;
+    // Stored under the lock, so a refresh that read older state cannot overwrite a newer one.
+    std::atomic_store(&notices_, std::shared_ptr<const Notices>(std::move(notices)));
   }
-  std::atomic_store(&notices_, std::shared_ptr<const Notices>(std::move(notices)));
 }
 
 const std::string& PolicyServerNode::notice_for(const std::shared_ptr<const amytiss::Policy>& policy,
