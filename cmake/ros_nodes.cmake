@@ -2,10 +2,12 @@
 
 # The ROS layer: parameter/message conversions and the nodes' logic; nodes' main()s are tiny.
 add_library(amytiss_ros
+  src/ros/checked_get_input.cpp
   src/ros/config_from_params.cpp
   src/ros/conversions.cpp
   src/ros/plant_model.cpp
   src/ros/plant_simulator.cpp
+  src/ros/policy_follower.cpp
   src/ros/policy_server.cpp
   src/ros/synthesizer.cpp
   src/ros/synthesizer_monitor.cpp)
@@ -42,7 +44,8 @@ if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)
   # Conversions and parameters, no master needed.
   if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_conversions.cpp)
-    catkin_add_gtest(amytiss_ros_unit_tests test/ros/test_conversions.cpp test/ros/test_synthesizer_monitor.cpp)
+    catkin_add_gtest(amytiss_ros_unit_tests test/ros/test_conversions.cpp test/ros/test_synthesizer_monitor.cpp
+                     test/ros/test_policy_follower.cpp test/ros/test_checked_get_input.cpp)
     target_link_libraries(amytiss_ros_unit_tests amytiss_ros)
     target_compile_definitions(amytiss_ros_unit_tests PRIVATE AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
   endif()
@@ -55,7 +58,8 @@ if(CATKIN_ENABLE_TESTING)
       target_link_libraries(amytiss_rostest_${rostest_name} amytiss_ros)
       target_compile_definitions(amytiss_rostest_${rostest_name} PRIVATE
         AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
-        AMYTISS_SYNTHESIZER_BIN="$<TARGET_FILE:synthesizer>")
+        AMYTISS_SYNTHESIZER_BIN="$<TARGET_FILE:synthesizer>"
+        AMYTISS_POLICY_SERVER_BIN="$<TARGET_FILE:policy_server>")
     endif()
   endforeach()
 endif()

@@ -1,8 +1,12 @@
 #include "conversions.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
+#include "amytiss/errors.hpp"
 #include "amytiss/grid.hpp"
 
 namespace amytiss_ros {
@@ -59,6 +63,15 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamp
   command.valid = answer_state(policy, state.state, state.time_step, server_notice, command.input,
                                command.probability, command.message);
   name_policy(policy, command);
+}
+
+std::string convergence_notice(const amytiss::Policy& policy) {
+  if (policy.converged) return "";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "policy did not converge: gap %.3g after %u iterations; probabilities are certified lower bounds",
+                policy.gap, policy.iterations);
+  return text;
 }
 
 amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress) {
@@ -158,9 +171,35 @@ visualization_msgs::Marker make_car_marker(const std::vector<double>& state, con
   return marker;
 }
 
-visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config, const std::string& frame_id) {
+namespace {
+
+std::optional<amytiss::Box> stored_box(const YAML::Node& spec, const std::string& key) {
+  const YAML::Node box = spec[key];
+  if (!box || box.IsNull()) return std::nullopt;
+  try {
+    return amytiss::Box{box["lb"].as<std::vector<double>>(), box["ub"].as<std::vector<double>>()};
+  } catch (const YAML::Exception& error) {
+    throw amytiss::ConfigError("spec." + key, std::string("the stored box is not {lb: [..], ub: [..]}: ") + error.what());
+  }
+}
+
+}  // namespace
+
+MarkedSets marked_sets_from_yaml(const std::string& config_yaml) {
+  const YAML::Node root = YAML::Load(config_yaml);
+  MarkedSets sets;
+  if (root["name"]) sets.config_name = root["name"].as<std::string>();
+  const YAML::Node spec = root["spec"];
+  if (!spec) return sets;
+  sets.safe = stored_box(spec, "safe");
+  sets.target = stored_box(spec, "target");
+  sets.avoid = stored_box(spec, "avoid");
+  return sets;
+}
+
+visualization_msgs::MarkerArray make_set_markers(const amytiss::Grid& states, const MarkedSets& sets,
+                                                 const std::string& frame_id) {
   visualization_msgs::MarkerArray markers;
-  const amytiss::Grid states(config.states);
   // The covered set is the union of cells: half a cell beyond the outermost points.
   std::vector<double> covered_lb = states.lb(), covered_ub = states.last_point();
   for (std::size_t i = 0; i < states.dims(); ++i) {
@@ -168,15 +207,12 @@ visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config, 
     covered_ub[i] += 0.5 * states.eta()[i];
   }
   markers.markers.push_back(outline(project(covered_lb, covered_ub), frame_id, "grid_bounds", 0.2f, 0.2f, 0.2f));
-  if (config.spec.target)
-    markers.markers.push_back(
-        filled_box(project(config.spec.target->lb, config.spec.target->ub), frame_id, "target", 0.1f, 0.8f, 0.1f));
-  if (config.spec.avoid)
-    markers.markers.push_back(
-        filled_box(project(config.spec.avoid->lb, config.spec.avoid->ub), frame_id, "avoid", 0.9f, 0.1f, 0.1f));
-  if (config.spec.safe)
-    markers.markers.push_back(
-        outline(project(config.spec.safe->lb, config.spec.safe->ub), frame_id, "safe", 0.1f, 0.3f, 0.9f));
+  if (sets.target)
+    markers.markers.push_back(filled_box(project(sets.target->lb, sets.target->ub), frame_id, "target", 0.1f, 0.8f, 0.1f));
+  if (sets.avoid)
+    markers.markers.push_back(filled_box(project(sets.avoid->lb, sets.avoid->ub), frame_id, "avoid", 0.9f, 0.1f, 0.1f));
+  if (sets.safe)
+    markers.markers.push_back(outline(project(sets.safe->lb, sets.safe->ub), frame_id, "safe", 0.1f, 0.3f, 0.9f));
   return markers;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // Conversions between core types and amytiss messages. Pure functions: no node, no master.
+#include <optional>
 #include <string>
 
 #include <amytiss/GetInput.h>
@@ -11,6 +12,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
+#include "amytiss/grid.hpp"
 #include "amytiss/model.hpp"
 #include "amytiss/policy.hpp"
 
@@ -31,17 +33,34 @@ void fill_get_input_response(const amytiss::Policy* policy, const std::vector<do
 void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
                         const std::string& server_notice, amytiss::InputCommand& command);
 
+/// "" for a converged policy (Policy::converged: an unbounded specification's interval iteration
+/// may stop before the gap between its bounds closes to the tolerance), otherwise the warning every answer of it carries: "policy did not
+/// converge: gap 3.2e-04 after 5000 iterations; probabilities are certified lower bounds".
+std::string convergence_notice(const amytiss::Policy& policy);
+
 /// Action feedback from engine progress.
 amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& progress);
 
 /// "synthesis 42% (step 7/16) on reference, about 3.1 s left" for status and logs.
 std::string describe_progress(const amytiss::Progress& progress);
 
+/// What the markers show of a configuration: its name and its specification's sets (absent: not
+/// in the specification), in state units.
+struct MarkedSets {
+  std::string config_name;
+  std::optional<amytiss::Box> safe, target, avoid;
+};
+
+/// Reads the name and the spec's safe, target and avoid boxes from a policy file's stored
+/// configuration (canonical YAML, see docs/policy_file.md) without parsing and validating the rest:
+/// the file's checksums vouch for it. Throws amytiss::ConfigError naming the key when a box is
+/// not {lb: [...], ub: [...]}.
+MarkedSets marked_sets_from_yaml(const std::string& config_yaml);
+
 /// Latched RViz markers over the x0/x1 projection (x1 = 0 for a one-dimensional state):
-/// the covered set's outline (grid bounds: outermost cells' edges), and boxes for the target
-/// (green), avoid (red) and safe (blue outline) sets of the configuration. Units: state units,
-/// in `frame_id`.
-visualization_msgs::MarkerArray make_set_markers(const amytiss::Config& config,
+/// the covered set's outline (grid bounds: outermost cells' edges of `states`), and boxes for the
+/// target (green), avoid (red) and safe (blue outline) sets. Units: state units, in `frame_id`.
+visualization_msgs::MarkerArray make_set_markers(const amytiss::Grid& states, const MarkedSets& sets,
                                                  const std::string& frame_id);
 
 /// RViz marker of a car's body at `state` (configuration order, state units): a blue box of the

@@ -19,6 +19,8 @@
 
 namespace {
 
+constexpr double kReadyWaitSeconds = 600.0;  // the synthesis of the benchmark's configuration
+
 struct ThreadResult {
   std::vector<double> latencies_us;
   std::size_t failures = 0;
@@ -73,10 +75,13 @@ int main(int argc, char** argv) {
   const std::size_t threads = std::stoul(argv[1]), calls = std::stoul(argv[2]);
   const unsigned seed = argc > 3 ? unsigned(std::stoul(argv[3])) : 1u;
   ros::NodeHandle handle;
-  const auto status = ros::topic::waitForMessage<amytiss::PolicyStatus>("/amytiss/status", handle,
-                                                                             ros::Duration(600.0));
+  // The first status may come before the synthesis ends: wait for a ready one.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kReadyWaitSeconds);
+  amytiss::PolicyStatus::ConstPtr status;
+  while ((!status || !status->ready) && ros::ok() && ros::WallTime::now() < deadline)
+    status = ros::topic::waitForMessage<amytiss::PolicyStatus>("/amytiss/status", handle, ros::Duration(1.0));
   if (!status || !status->ready) {
-    std::fprintf(stderr, "no ready policy on /amytiss/status\n");
+    std::fprintf(stderr, "no ready policy on /amytiss/status within %.0f s\n", kReadyWaitSeconds);
     return 1;
   }
   if (!ros::service::waitForService("/amytiss/get_input", ros::Duration(60.0))) {

@@ -1,6 +1,9 @@
 // rostest: the policy server's service and closed-loop topics against the core policy.
 #include <cmath>
+#include <cstdio>
 #include <condition_variable>
+#include <cstring>
+#include <fstream>
 #include <limits>
 #include <random>
 
@@ -9,12 +12,39 @@
 #include <amytiss/StateStamped.h>
 
 #include "amytiss/policy_file.hpp"
+#include "rostest_nodes.hpp"
 #include "rostest_support.hpp"
+
+// A request written byte by byte, to send what no well-formed client would.
+struct RawRequest {
+  std::vector<std::uint8_t> bytes;
+};
+
+namespace ros::serialization {
+template <>
+struct Serializer<RawRequest> {
+  template <typename Stream>
+  static void write(Stream& stream, const RawRequest& request) {
+    std::memcpy(stream.advance(std::uint32_t(request.bytes.size())), request.bytes.data(), request.bytes.size());
+  }
+  static std::uint32_t serializedLength(const RawRequest& request) { return std::uint32_t(request.bytes.size()); }
+};
+}  // namespace ros::serialization
 
 namespace {
 
 constexpr int kSampledStates = 300;
 constexpr unsigned kRandomSeed = 20240601;
+// Decoding the oversized request would allocate 4 GiB; the server may grow by far less than that.
+constexpr long kOversizedGrowthLimitKiB = 512L * 1024;
+
+// The peak virtual memory of a process (VmPeak in /proc/<pid>/status), in KiB; -1 if unreadable.
+long peak_memory_kib(int pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmPeak:", 0) == 0) return std::stol(line.substr(7));
+  return -1;
+}
 
 class ServiceTest : public ::testing::Test {
  protected:
@@ -25,10 +55,13 @@ class ServiceTest : public ::testing::Test {
     ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.ready; },
                                  amytiss_test::kPolicyWaitSeconds))
         << "no ready policy; last status: " << status_.latest().message;
-    loaded_ = amytiss::read_policy_file(status_.latest().policy_file);
+    policy_file_ = status_.latest().policy_file;
+    loaded_ = amytiss::read_policy_file(policy_file_);
     // The server loads the file after the status arrives: wait until it answers.
     ASSERT_TRUE(amytiss_test::poll_until([&] { return call({-4.0, -4.0}, 0).success; }, amytiss_test::kPolicyWaitSeconds));
   }
+  // The policy file is this run's own (service.test names it with $(anon ...)): removed at the end.
+  static void TearDownTestSuite() { std::remove(policy_file_.c_str()); }
   amytiss::GetInput::Response call(const std::vector<double>& state, unsigned step) {
     amytiss::GetInput service;
     service.request.state = state;
@@ -41,7 +74,10 @@ class ServiceTest : public ::testing::Test {
   amytiss_test::StatusWatcher status_{handle_};
   ros::ServiceClient client_;
   amytiss::LoadedPolicy loaded_;
+  static std::string policy_file_;
 };
+
+std::string ServiceTest::policy_file_;
 
 TEST_F(ServiceTest, AnswersEqualTheCorePolicyForSampledStates) {
   const amytiss::Policy& policy = loaded_.policy;
@@ -85,6 +121,25 @@ TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStays
   }
   EXPECT_TRUE(client_.exists());
   EXPECT_TRUE(call({-4.0, -4.0}, 0).success);
+}
+
+TEST_F(ServiceTest, ARequestClaimingMoreStateValuesThanItCarriesIsAnsweredWithoutTheAllocation) {
+  const int server = amytiss_test::node_pid("/amytiss/policy_server");
+  ASSERT_GT(server, 0);
+  const long peak_before = peak_memory_kib(server);
+  ASSERT_GT(peak_before, 0);
+  // 16 bytes: a state length of 2^29 (4 GiB of doubles if decoded), 8 bytes, a time step.
+  RawRequest oversized{std::vector<std::uint8_t>(16, 0)};
+  const std::uint32_t claimed = 1u << 29;
+  std::memcpy(oversized.bytes.data(), &claimed, sizeof claimed);
+  ros::ServiceClient raw_client = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input");
+  amytiss::GetInput::Response response;
+  ASSERT_TRUE(raw_client.call(oversized, response, ros::service_traits::md5sum<amytiss::GetInput>()))
+      << "the server must answer, not fail the call";
+  EXPECT_FALSE(response.success);
+  EXPECT_NE(response.message.find("claims 536870912 values"), std::string::npos) << response.message;
+  EXPECT_LT(peak_memory_kib(server) - peak_before, kOversizedGrowthLimitKiB);
+  EXPECT_TRUE(call({-4.0, -4.0}, 0).success) << "the server stays up";
 }
 
 TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {

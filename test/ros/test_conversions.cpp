@@ -278,8 +278,13 @@ TEST(ProgressConversions, FeedbackCarriesEveryField) {
 }
 
 TEST(Markers, GridBoundsTargetAndAvoid) {
+  // Read as the policy server does: from the stored canonical YAML, without validating it again.
   const amytiss::Config config = amytiss::load_config_file(kTinyConfig);
-  const visualization_msgs::MarkerArray markers = amytiss_ros::make_set_markers(config, "map");
+  const amytiss_ros::MarkedSets sets = amytiss_ros::marked_sets_from_yaml(amytiss::to_yaml(config));
+  EXPECT_EQ(sets.config_name, config.name);
+  EXPECT_FALSE(sets.safe.has_value());
+  const visualization_msgs::MarkerArray markers =
+      amytiss_ros::make_set_markers(amytiss::Grid(config.states), sets, "map");
   ASSERT_EQ(markers.markers.size(), 3u);
   const auto& bounds = markers.markers[0];
   EXPECT_EQ(bounds.ns, "grid_bounds");
@@ -292,6 +297,26 @@ TEST(Markers, GridBoundsTargetAndAvoid) {
   EXPECT_DOUBLE_EQ(target.scale.y, 1.5);
   EXPECT_EQ(markers.markers[2].ns, "avoid");
   EXPECT_EQ(markers.markers[2].header.frame_id, "map");
+}
+
+TEST(Convergence, APolicyWhoseGapDidNotCloseSaysSoWithTheGap) {
+  amytiss::Policy policy;
+  policy.stationary = true;
+  policy.iterations = 5000;
+  policy.gap = 3.2e-4;
+  EXPECT_EQ("", amytiss_ros::convergence_notice(policy));
+  policy.converged = false;
+  EXPECT_EQ("policy did not converge: gap 0.00032 after 5000 iterations; probabilities are certified lower bounds",
+            amytiss_ros::convergence_notice(policy));
+}
+
+TEST(Markers, AStoredBoxThatIsNotABoxIsRefusedNamingItsKey) {
+  try {
+    amytiss_ros::marked_sets_from_yaml("name: broken\nspec: {type: safety, horizon: 3, safe: {lb: 1}}\n");
+    FAIL() << "a box without ub was read";
+  } catch (const amytiss::ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("spec.safe"), std::string::npos) << error.what();
+  }
 }
 
 TEST(Markers, CarBodyFollowsTheState) {
