@@ -35,11 +35,13 @@ struct Abstraction {
   bool unbounded = false;  ///< horizon: infinite (interval iteration, stationary policy)
   double tolerance = 0;    ///< unbounded: stop when upper - lower <= tolerance everywhere
 
-  /// Validates and builds. Throws ConfigError.
+  /// Builds from a configuration that passed Config::validate() (config_from_yaml and
+  /// load_config_file validate; this does not judge it again). Throws std::logic_error when an
+  /// invariant validate() guarantees does not hold (a bug of the caller).
   static Abstraction from_config(const Config& config);
-  /// Builds from a configuration and given dynamics (tests: lambda dynamics) without calling
-  /// Config::validate() or make_dynamics(); still checks what it uses (grids, noise, sets, horizon,
-  /// the dynamics' dimensions) and throws ConfigError.
+  /// Builds from a validated configuration and given dynamics (tests: lambda dynamics) without
+  /// make_dynamics(). Throws std::logic_error when what it uses (grids, noise, sets, horizon, the
+  /// dynamics' dimensions) breaks an invariant of a validated configuration.
   static Abstraction from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics);
 
   /// V_{T_d} of a cell with the given role.
@@ -53,7 +55,8 @@ struct Abstraction {
 /// closed box). Safety: outside `safe` -> FixedZero (no `safe`: all Free). Reachability: target ->
 /// FixedOne. Reach-avoid: avoid -> FixedZero, target -> FixedOne; a cell in both (a configuration
 /// error that validate() rejects) is FixedZero: avoid is applied first and wins.
-/// Throws ConfigError for a missing target or a box of the wrong dimension.
+/// Throws std::logic_error for a missing target or a box of the wrong dimension (validate()
+/// refuses both).
 std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec);
 
 }  // namespace amytiss

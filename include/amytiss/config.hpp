@@ -52,7 +52,12 @@ struct NoiseConfig {
   std::optional<Box> support;
   Truncation truncation = Truncation::None;  ///< default: nothing cut (exact)
   /// cutting_probability: total probability mass that may be cut per transition, in (0, 1).
-  double cutting_probability = 1e-3;
+  /// Absent: kDefaultCuttingProbability; it may only be given with truncation cutting_probability.
+  std::optional<double> cutting_probability;
+  static constexpr double kDefaultCuttingProbability = 1e-3;
+  double cutting_probability_or_default() const {
+    return cutting_probability.value_or(kDefaultCuttingProbability);
+  }
   /// fixed_region: half-widths of the kept box around the post mean, per dimension (state units).
   std::vector<double> fixed_region;
 };
@@ -78,7 +83,10 @@ struct SpecConfig {
   /// `horizon: infinite`: the unbounded specification, solved by interval iteration until the
   /// upper and the lower bound differ by at most `tolerance` everywhere; the policy is stationary.
   bool unbounded = false;
-  double tolerance = 1e-6;    ///< unbounded only: in (0, 1)
+  /// Unbounded only: in (0, 1). Absent: kDefaultTolerance; it may only be given with `horizon: infinite`.
+  std::optional<double> tolerance;
+  static constexpr double kDefaultTolerance = 1e-6;
+  double tolerance_or_default() const { return tolerance.value_or(kDefaultTolerance); }
   std::optional<Box> safe;    ///< safety; absent: the whole grid
   std::optional<Box> target;  ///< reachability, reach_avoid
   std::optional<Box> avoid;   ///< reach_avoid (absent: empty)
@@ -143,11 +151,40 @@ struct Config {
   void validate() const;
 };
 
-/// Parses a YAML tree of the schema. Throws ConfigError naming the key on a missing key, a wrong
-/// type, an unknown enum value or an unknown key. Calls validate().
-Config config_from_yaml(const YAML::Node& root);
-/// Reads and parses a YAML file (ConfigError with key "<file>" when it cannot be read).
-Config load_config_file(const std::string& path);
+/// Values given beside a configuration that replace its `compute` keys: the CLI's --device,
+/// --transitions, --sweep, --platform and --devices, the ROS synthesizer's ~device. An empty
+/// text (list) keeps the configuration's value.
+struct ComputeOverrides {
+  /// How errors name an override: key_prefix + key, e.g. "--" + "device" for the CLI's option;
+  /// the default names the configuration key ("compute.device").
+  std::string key_prefix = "compute.";
+  std::string device;       ///< auto | cpu | gpu | reference
+  std::string transitions;  ///< auto | stored | on_the_fly
+  std::string sweep;        ///< auto | dense | factored
+  std::string platform;     ///< as compute.platform
+  std::vector<std::string> devices;  ///< as compute.devices
+};
+
+/// Replaces the compute keys the overrides give. The configuration is read but not yet validated:
+/// the caller validates after (config_from_yaml and load_config_file do). Throws ConfigError
+/// (key_prefix + key) for a device, transitions or sweep text that names no value.
+void apply_overrides(Config& config, const ComputeOverrides& overrides);
+
+/// Reads a YAML tree of the schema without judging the values: throws ConfigError naming the key
+/// only on a missing key, a wrong type (a text for a number, a fraction or a negative number for
+/// a count), an unknown enum value or an unknown key. Meaning is judged by Config::validate().
+Config read_config(const YAML::Node& root);
+/// The one gate for user input: read_config, then apply_overrides, then Config::validate() once.
+Config config_from_yaml(const YAML::Node& root, const ComputeOverrides& overrides = {});
+/// config_from_yaml of a YAML file (ConfigError with key "<file>" when it cannot be read or is
+/// not YAML).
+Config load_config_file(const std::string& path, const ComputeOverrides& overrides = {});
+/// A configuration this program stored beside its result (a policy file's configuration text,
+/// to_yaml()), read without judging it again: it was validated before the result was computed,
+/// and the file's config hash ties the two. Cheap (no grid, expression or density checks): for
+/// consumers that need the name, the spec boxes or the model of a policy. Throws ConfigError
+/// (key "config_yaml") for text that is not YAML or not of the schema.
+Config read_stored_config(const std::string& yaml_text);
 /// Canonical YAML text of the configuration: all keys, fixed order, full precision. Parsing it
 /// again gives an equal Config.
 std::string to_yaml(const Config& config);

@@ -8,7 +8,6 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
-#include "amytiss/enum_names.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/model_export.hpp"
 #include "amytiss/policy.hpp"
@@ -23,12 +22,6 @@ namespace {
 using namespace amytiss;
 using namespace amytiss::cli;
 
-template <typename Enum>
-Enum parse_enum_option(const std::string& option, const std::string& text) {
-  if (const auto value = enum_from_name<Enum>(text)) return *value;
-  throw UsageError(option + ": got '" + text + "', expected one of " + enum_name_list<Enum>());
-}
-
 std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> items;
   std::stringstream stream(text);
@@ -36,19 +29,16 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
-// The configuration file with the command line's overrides.
+// The configuration file with the command line's overrides, validated once (on the result).
 Config load_with_overrides(const Options& options) {
-  Config config = load_config_file(options.config_path);
-  if (!options.device.empty()) config.compute.device = parse_enum_option<DeviceKind>("--device", options.device);
-  if (!options.transitions.empty())
-    config.compute.transitions = parse_enum_option<TransitionStorage>("--transitions", options.transitions);
-  if (!options.sweep.empty()) config.compute.sweep = parse_enum_option<SweepChoice>("--sweep", options.sweep);
-  if (!options.platform.empty()) config.compute.platform = options.platform;
-  if (!options.devices.empty()) {
-    config.compute.devices = split_list(options.devices);
-    config.validate();
-  }
-  return config;
+  ComputeOverrides overrides;
+  overrides.key_prefix = "--";
+  overrides.device = options.device;
+  overrides.transitions = options.transitions;
+  overrides.sweep = options.sweep;
+  overrides.platform = options.platform;
+  if (!options.devices.empty()) overrides.devices = split_list(options.devices);
+  return load_config_file(options.config_path, overrides);
 }
 
 void print_problem(const Options& options, const Config& config, const Abstraction& abstraction) {

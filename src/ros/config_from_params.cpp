@@ -56,11 +56,9 @@ amytiss::Config config_from_tree(YAML::Node tree, const std::string& device_over
                                "node's private namespace (example: <rosparam command=\"load\" "
                                "file=\"$(find amytiss)/config/robot_reach_avoid.yaml\"/>)");
   for (const auto& key : kNodeParameterKeys) tree.remove(key);
-  if (!device_override.empty()) {
-    if (!tree["compute"] || !tree["compute"].IsMap()) tree["compute"] = YAML::Node(YAML::NodeType::Map);
-    tree["compute"]["device"] = device_override;
-  }
-  return amytiss::config_from_yaml(tree);
+  amytiss::ComputeOverrides overrides;
+  overrides.device = device_override;
+  return amytiss::config_from_yaml(tree, overrides);
 }
 
 }  // namespace

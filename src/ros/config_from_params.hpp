@@ -21,8 +21,8 @@ extern const std::vector<std::string> kNodeParameterKeys;
 YAML::Node yaml_from_xmlrpc(XmlRpc::XmlRpcValue& value, const std::string& path = "", std::size_t depth = 0);
 
 /// Converts the private-namespace tree (a struct) to a validated configuration: drops
-/// kNodeParameterKeys, applies `device_override` to compute.device when it is not empty
-/// ("auto", "cpu", "gpu", "reference"), then amytiss::config_from_yaml. Throws ConfigError.
+/// kNodeParameterKeys, then amytiss::config_from_yaml with `device_override` as the override of
+/// compute.device when it is not empty ("auto", "cpu", "gpu", "reference"). Throws ConfigError.
 amytiss::Config config_from_params(XmlRpc::XmlRpcValue& private_params,
                                    const std::string& device_override = "");
 

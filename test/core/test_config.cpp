@@ -113,7 +113,7 @@ TEST(Config, WrongTypes) {
 
   root = base();
   root["spec"]["horizon"] = 2.5;
-  expect_error(root, "spec.horizon", "expected an integer >= 1");
+  expect_error(root, "spec.horizon", "got 2.5, expected an integer");
 
   root = base();
   root["spec"]["horizon"] = -3;

@@ -79,13 +79,14 @@ inline Box box(std::vector<double> lb, std::vector<double> ub) {
 
 /// Additive normal noise; covariance: n values (diagonal) or n*n (full).
 inline NoiseConfig normal_noise(std::vector<double> covariance, Truncation truncation = Truncation::None,
-                                double cutting_probability = 1e-3, std::vector<double> fixed_region = {}) {
+                                double cutting_probability = NoiseConfig::kDefaultCuttingProbability,
+                                std::vector<double> fixed_region = {}) {
   NoiseConfig noise;
   noise.type = NoiseType::Additive;
   noise.distribution = Distribution::Normal;
   noise.covariance = std::move(covariance);
   noise.truncation = truncation;
-  noise.cutting_probability = cutting_probability;
+  if (truncation == Truncation::CuttingProbability) noise.cutting_probability = cutting_probability;
   noise.fixed_region = std::move(fixed_region);
   return noise;
 }

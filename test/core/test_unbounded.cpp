@@ -349,7 +349,7 @@ TEST(Unbounded, SeveralDevicesAreRefused) {
 TEST(Unbounded, ConfigurationKeys) {
   const Config config = config_from_yaml(YAML::Load(kRuin));
   EXPECT_TRUE(config.spec.unbounded);
-  EXPECT_EQ(config.spec.tolerance, 1e-6);
+  EXPECT_EQ(config.spec.tolerance_or_default(), 1e-6);
   EXPECT_EQ(config_from_yaml(YAML::Load(to_yaml(config))).spec.unbounded, true);
   auto error_key = [](const std::string& text) {
     try {

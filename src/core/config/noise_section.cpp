@@ -187,9 +187,12 @@ void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::st
   } else {
     check_law_noise(noise, n, constants);
   }
-  if (!(noise.cutting_probability > 0 && noise.cutting_probability < 1))
-    fail("noise.cutting_probability", format_number(noise.cutting_probability), "a probability in (0, 1)",
-         "cutting_probability: 1.0e-3");
+  if (noise.cutting_probability && noise.truncation != Truncation::CuttingProbability)
+    throw ConfigError("noise.cutting_probability", "given but noise.truncation is " + to_string(noise.truncation) +
+                                                       "; set truncation: cutting_probability to use it");
+  const double gamma = noise.cutting_probability_or_default();
+  if (!(gamma > 0 && gamma < 1))
+    fail("noise.cutting_probability", format_number(gamma), "a probability in (0, 1)", "cutting_probability: 1.0e-3");
   if (noise.truncation == Truncation::FixedRegion) {
     const std::string example = "fixed_region: [" + n_text + " half-widths in state units]";
     if (noise.fixed_region.size() != n)

@@ -66,13 +66,13 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   if (noise.support) text += "  support: " + box_yaml(*noise.support) + "\n";
   text += "  truncation: " + to_string(noise.truncation) + "\n";
   if (noise.truncation == Truncation::CuttingProbability)
-    text += "  cutting_probability: " + format_number(noise.cutting_probability) + "\n";
+    text += "  cutting_probability: " + format_number(noise.cutting_probability_or_default()) + "\n";
   if (!noise.fixed_region.empty()) text += "  fixed_region: " + format_list(noise.fixed_region) + "\n";
   text += "spec:\n";
   text += "  type: " + to_string(config.spec.type) + "\n";
   if (config.spec.unbounded) {
     text += "  horizon: infinite\n";
-    text += "  tolerance: " + format_number(config.spec.tolerance) + "\n";
+    text += "  tolerance: " + format_number(config.spec.tolerance_or_default()) + "\n";
   } else {
     text += "  horizon: " + std::to_string(config.spec.horizon) + "\n";
   }

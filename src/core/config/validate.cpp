@@ -21,6 +21,7 @@ using detail::join;
 
 constexpr std::uint64_t kMaxGridPoints = 4294967295ull;          // 2^32 - 1: indices are uint32
 constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
+constexpr unsigned kMaxHorizon = 1000000000;  // the policy arrays' 16 GiB limit is checked apart
 
 const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
 
@@ -205,10 +206,18 @@ void Config::validate() const {
   check_noise(noise, n, constants);
 
   if (spec.unbounded) {
-    if (!(spec.tolerance > 0 && spec.tolerance < 1))
-      fail("spec.tolerance", format_number(spec.tolerance), "a number in (0, 1)", "tolerance: 1.0e-6");
-  } else if (spec.horizon == 0) {
-    fail("spec.horizon", "0", "an integer >= 1 (number of time steps) or infinite", "horizon: 16");
+    const double tolerance = spec.tolerance_or_default();
+    if (!(tolerance > 0 && tolerance < 1))
+      fail("spec.tolerance", format_number(tolerance), "a number in (0, 1)", "tolerance: 1.0e-6");
+  } else {
+    if (spec.tolerance)
+      throw ConfigError("spec.tolerance", "given but spec.horizon is " + std::to_string(spec.horizon) +
+                                              "; the tolerance is for horizon: infinite");
+    if (spec.horizon < 1 || spec.horizon > kMaxHorizon)
+      fail("spec.horizon", std::to_string(spec.horizon),
+           "an integer >= 1 and <= 1000000000 (number of time steps; the policy arrays must also fit in 16 GiB) "
+           "or infinite",
+           "horizon: 16 (or horizon: infinite)");
   }
   switch (spec.type) {
     case SpecType::Safety:

@@ -49,7 +49,6 @@ std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
 }
 
 Abstraction Abstraction::from_config(const Config& config) {
-  config.validate();
   std::shared_ptr<const Dynamics> dynamics = make_dynamics(config);
   return from_parts(config, std::move(dynamics));
 }
@@ -70,7 +69,7 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
   require(config.spec.unbounded || config.spec.horizon > 0, "a horizon of at least one step");
   abstraction.spec = config.spec.type;
   abstraction.unbounded = config.spec.unbounded;
-  abstraction.tolerance = config.spec.tolerance;
+  abstraction.tolerance = config.spec.tolerance_or_default();
   // An unbounded specification's stationary policy is laid out like one step of a finite one.
   abstraction.horizon = config.spec.unbounded ? 1 : config.spec.horizon;
   abstraction.roles = cell_roles(abstraction.states, config.spec);

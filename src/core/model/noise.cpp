@@ -223,7 +223,7 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states, const std:
       break;
     }
     case Truncation::CuttingProbability: {
-      const double gamma = config.cutting_probability;
+      const double gamma = config.cutting_probability_or_default();
       require(gamma > 0 && gamma < 1, "a cutting probability in (0, 1)");
       if (distribution_ == Distribution::Normal) {
         // Union bound over dimensions: each may lose gamma/n, split over both tails.
