@@ -31,6 +31,9 @@ constexpr std::size_t kMaxExpressionLength = 65536;  // characters
 constexpr std::size_t kMaxExpressionDepth = 256;     // nesting levels: '(', arguments, '?:', unary, '^'
 constexpr std::size_t kMaxExpressionNodes = 10000;   // numbers, variables, operators and calls
 
+/// Whether `name` is a function of the grammar ("sin", ..., "if"): such a name cannot be a constant.
+bool is_function_name(const std::string& name);
+
 /// `text` itself when short, else its first characters and its length: for error messages.
 std::string expression_excerpt(const std::string& text);
 
