@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/grid_rules.hpp"
 
 namespace amytiss {
 
@@ -39,7 +40,7 @@ class Grid {
   /// state lies outside the covered set (beyond half a cell from the outermost points) or is not
   /// finite. O(dims), no allocation.
   std::optional<std::size_t> cell_of(const double* state) const;
-  /// Whether the point of flat index lies in the closed box (with a 1e-9*eta tolerance).
+  /// Whether the point of flat index lies in the closed box (coordinate_in_box, grid_rules.hpp).
   bool point_in_box(std::size_t flat, const Box& box) const;
 
  private:
@@ -47,8 +48,5 @@ class Grid {
   std::vector<std::size_t> counts_, strides_;
   std::size_t size_ = 1;
 };
-
-/// Number of points of one dimension: floor((ub - lb)/eta + 0.5) + 1.
-std::size_t grid_count(double lb, double ub, double eta);
 
 }  // namespace amytiss

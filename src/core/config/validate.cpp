@@ -6,6 +6,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/expression.hpp"
+#include "amytiss/grid_rules.hpp"
 #include "amytiss/model.hpp"
 #include "config/messages.hpp"
 
@@ -24,10 +25,6 @@ constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
 constexpr unsigned kMaxHorizon = 1000000000;  // the policy arrays' 16 GiB limit is checked apart
 
 const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
-
-std::uint64_t points_of_dimension(double lb, double ub, double eta) {
-  return static_cast<std::uint64_t>(std::floor((ub - lb) / eta + 0.5)) + 1;
-}
 
 /// Checks a grid and returns its number of points (saturated at UINT64_MAX).
 double check_grid(const GridSpec& grid, const std::string& key, const std::string& omit_hint) {
@@ -50,7 +47,7 @@ double check_grid(const GridSpec& grid, const std::string& key, const std::strin
     if (grid.lb[i] > grid.ub[i])
       fail(indexed(key + ".ub", i), format_number(grid.ub[i]),
            "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(grid.lb[i]), example);
-    points *= std::floor((grid.ub[i] - grid.lb[i]) / grid.eta[i] + 0.5) + 1;
+    points *= grid_points(grid.lb[i], grid.ub[i], grid.eta[i]);
   }
   if (points > double(kMaxGridPoints))
     throw ConfigError(key, "grid too large: " + format_number(points) +
@@ -58,26 +55,15 @@ double check_grid(const GridSpec& grid, const std::string& key, const std::strin
   return points;
 }
 
-// Grid indices first..last of dimension i that a (validated) box contains, by the membership rule
-// of Grid::point_in_box (closed box, 1e-9*eta tolerance).
-std::pair<double, double> box_index_range(const Box& box, const GridSpec& states, std::size_t i) {
-  const double eta = states.eta[i];
-  const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
-  const double first = std::max(0.0, std::ceil((box.lb[i] - states.lb[i]) / eta - 1e-9));
-  const double last = std::min(count - 1, std::floor((box.ub[i] - states.lb[i]) / eta + 1e-9));
-  return {first, last};
-}
-
 // A cell in both boxes would silently become avoid (avoid wins in the roles): refuse it.
 void check_target_avoid_disjoint(const Box& target, const Box& avoid, const GridSpec& states) {
   std::vector<double> shared;
   for (std::size_t i = 0; i < states.lb.size(); ++i) {
-    const auto target_range = box_index_range(target, states, i);
-    const auto avoid_range = box_index_range(avoid, states, i);
-    const double first = std::max(target_range.first, avoid_range.first);
-    const double last = std::min(target_range.second, avoid_range.second);
-    if (first > last) return;
-    shared.push_back(states.lb[i] + first * states.eta[i]);
+    const IndexRange in_target = box_index_range(states, i, target.lb[i], target.ub[i]);
+    const IndexRange in_avoid = box_index_range(states, i, avoid.lb[i], avoid.ub[i]);
+    const std::int64_t first = std::max(in_target.first, in_avoid.first);
+    if (first > std::min(in_target.last, in_avoid.last)) return;
+    shared.push_back(states.lb[i] + double(first) * states.eta[i]);
   }
   throw ConfigError("spec.avoid", "the avoid box " + format_list(avoid.lb) + " .. " + format_list(avoid.ub) +
                                       " and the target box " + format_list(target.lb) + " .. " +
@@ -100,11 +86,11 @@ void check_box(const Box& box, const std::string& key, const GridSpec& states) {
     if (box.lb[i] > box.ub[i])
       fail(indexed(key + ".ub", i), format_number(box.ub[i]),
            "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(box.lb[i]), example);
-    // Same membership rule as Grid::point_in_box: closed box with a 1e-9*eta tolerance.
+    // The membership rule of Grid::point_in_box (grid_rules.hpp).
     const double eta = states.eta[i];
-    const double count = double(points_of_dimension(states.lb[i], states.ub[i], eta));
-    const auto [first, last] = box_index_range(box, states, i);
-    if (first > last)
+    const double count = double(grid_count(states.lb[i], states.ub[i], eta));
+    const IndexRange inside = box_index_range(states, i, box.lb[i], box.ub[i]);
+    if (inside.first > inside.last)
       throw ConfigError(key, "the box " + format_list(box.lb) + " .. " + format_list(box.ub) +
                                  " contains no representative point of the state grid in dimension " +
                                  std::to_string(i) + " (points " + format_number(states.lb[i]) + ", " +
@@ -127,9 +113,6 @@ bool looks_like_variable(const std::string& name) {
     if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
   return true;
 }
-
-const std::vector<std::string> kFunctionNames = {"sin", "cos",  "tan", "asin", "acos", "atan",  "atan2", "exp", "log",
-                                                 "sqrt", "pow", "abs", "min", "max",  "floor", "ceil",  "if"};
 
 void check_integrator(const IntegratorConfig& integrator, bool expressions, std::size_t n) {
   const char* const example = "integrator: {method: rk4, substeps: 4, tau: 0.1}";
@@ -164,8 +147,8 @@ void Config::validate() const {
   for (const auto& constant : constants) {
     const std::string key = "constants." + constant.first;
     // z is the variable of noise densities.
-    bool reserved = constant.first == "pi" || constant.first == "z" || looks_like_variable(constant.first);
-    for (const auto& function : kFunctionNames) reserved = reserved || function == constant.first;
+    const bool reserved = constant.first == "pi" || constant.first == "z" || looks_like_variable(constant.first) ||
+                          is_function_name(constant.first);
     if (!is_identifier(constant.first) || reserved)
       throw ConfigError(key, "got the name '" + constant.first +
                                  "', expected a name of letters, digits and '_' that is not pi, a variable "

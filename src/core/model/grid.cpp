@@ -10,10 +10,6 @@
 
 namespace amytiss {
 
-std::size_t grid_count(double lb, double ub, double eta) {
-  return static_cast<std::size_t>(std::floor((ub - lb) / eta + 0.5)) + 1;
-}
-
 Grid::Grid(const GridSpec& spec) {
   const std::size_t dims = spec.lb.size();
   // The spec passed Config::validate() (which names the key); a violation is a bug of the caller.
@@ -35,7 +31,7 @@ Grid::Grid(const GridSpec& spec) {
                                     ", expected a positive number");
     if (spec.lb[d] > spec.ub[d])
       throw std::logic_error("Grid: expected a validated grid: " + std::string() + "lb[" + std::to_string(d) + "] > ub[" + std::to_string(d) + "]");
-    const double count = std::floor((spec.ub[d] - spec.lb[d]) / spec.eta[d] + 0.5) + 1;
+    const double count = grid_points(spec.lb[d], spec.ub[d], spec.eta[d]);
     if (count > 1e15 || double(size_) * count > 1e18)
       throw std::logic_error("Grid: expected a validated grid: " + std::string() + "the grid has more points than can be indexed");
     counts_[d] = grid_count(spec.lb[d], spec.ub[d], spec.eta[d]);
@@ -109,9 +105,7 @@ std::optional<std::size_t> Grid::cell_of(const double* state) const {
 bool Grid::point_in_box(std::size_t flat, const Box& box) const {
   for (std::size_t d = 0; d < dims(); ++d) {
     const std::size_t k = (flat / strides_[d]) % counts_[d];
-    const double coordinate_value = coordinate(d, k);
-    const double slack = 1e-9 * eta_[d];
-    if (coordinate_value < box.lb[d] - slack || coordinate_value > box.ub[d] + slack) return false;
+    if (!coordinate_in_box(coordinate(d, k), box.lb[d], box.ub[d], eta_[d])) return false;
   }
   return true;
 }
