@@ -110,7 +110,7 @@ class NoiseModel {
                    double* out) const;
 
   /// Non-separable (full covariance) mass of the box [lo, hi] with mean `mean`. Method and error
-  /// bound in model/noise.cpp and docs/semantics.md ("Transition probabilities"); |error| <= box_mass_tolerance().
+  /// bound in model/full_covariance.cpp and docs/semantics.md ("Transition probabilities"); |error| <= box_mass_tolerance().
   /// Method: sequential conditioning x = mean + L z (L Cholesky, z standard normal), nested
   /// composite Gauss-Legendre over z_0..z_{n-2} (panel width <= 1 standard deviation, narrowed
   /// where later bounds depend steeply on z_i), exact erfc for z_{n-1}, z clipped to |z| <= 9.
@@ -146,7 +146,7 @@ class NoiseModel {
   std::vector<std::size_t> counts_;     // the state grid's points per dimension
   std::vector<std::int64_t> window_half_cells_;
   std::vector<char> whole_grid_dims_;  // truncation none (and some noise): the whole dimension
-  // Full covariance quadrature (see model/noise.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
+  // Full covariance quadrature (see model/full_covariance.cpp): Gauss-Legendre nodes/weights on [-1, 1] and the
   // panel width per conditioning level in standard-normal units.
   std::vector<double> legendre_nodes_, legendre_weights_;
   std::vector<double> panel_width_;
@@ -158,6 +158,15 @@ class NoiseModel {
   std::vector<double> window_offset_;
   std::vector<std::shared_ptr<const detail::UnitLaw>> laws_;  // exponential, beta, custom
   std::size_t grid_size_ = 1;
+
+  // Set-up steps of the constructor, one per job (model/noise.cpp, model/full_covariance.cpp).
+  void set_up_normal(const NoiseConfig& config);
+  void set_up_window(const NoiseConfig& config, const Grid& states);
+  void set_half_cells(std::size_t dim, double half_cells);
+  void set_up_fixed_region(const NoiseConfig& config, const std::vector<double>& largest_scale);
+  void set_up_cutting_probability(const NoiseConfig& config, const std::vector<double>& largest_scale);
+  void set_up_custom_error_bound();
+  void set_up_full_covariance(const Grid& states);
 };
 
 /// Lower-triangular Cholesky factor L (row-major n*n, matrix = L L^T) of a symmetric n*n matrix
