@@ -4,35 +4,14 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "amytiss/errors.hpp"
-#include "amytiss/noise.hpp"
-
 namespace amytiss_ros {
 
 PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
-    : config_(config), dynamics_(amytiss::make_dynamics(config)), random_(seed) {
-  state_dims_ = config.states.lb.size();
-  const std::size_t n = state_dims_;
-  noise_factor_.assign(n * n, 0.0);
-  const auto& noise = config.noise;
-  if (noise.distribution != amytiss::Distribution::Normal && noise.distribution != amytiss::Distribution::Uniform)
-    throw amytiss::ConfigError("noise.distribution", "the plant simulator cannot draw " +
-                                                         amytiss::to_string(noise.distribution) +
-                                                         " noise yet (it draws normal and uniform noise)");
-  if (noise.distribution == amytiss::Distribution::Uniform) {
-    for (std::size_t i = 0; i < n; ++i) noise_factor_[i * n + i] = noise.half_width.at(i);
-    return;
-  }
-  if (noise.covariance.size() == n) {
-    for (std::size_t i = 0; i < n; ++i) noise_factor_[i * n + i] = std::sqrt(noise.covariance[i]);
-    return;
-  }
-  // Full covariance: Cholesky factor L (Sigma = L L^T), so L z with z ~ N(0, I) has covariance Sigma.
-  // The configuration passed validate(), which refuses a covariance without this factor.
-  auto factor = amytiss::cholesky_factor(noise.covariance, n);
-  if (!factor) throw std::logic_error("PlantModel: expected a validated configuration (positive definite covariance)");
-  noise_factor_ = std::move(*factor);
-}
+    : config_(config),
+      dynamics_(amytiss::make_dynamics(config)),
+      state_dims_(config.states.lb.size()),
+      noise_(config.noise, state_dims_, config.constants),
+      random_(seed) {}
 
 std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {
   std::vector<double> disturbance;
@@ -50,18 +29,7 @@ std::vector<double> PlantModel::step(const std::vector<double>& state, const std
 }
 
 std::vector<double> PlantModel::draw_noise(const std::vector<double>& state) {
-  const std::size_t n = state_dims_;
-  std::vector<double> standard(n);
-  const bool uniform = config_.noise.distribution == amytiss::Distribution::Uniform;
-  for (auto& z : standard)
-    z = uniform ? std::uniform_real_distribution<double>(-1.0, 1.0)(random_)
-                : std::normal_distribution<double>(0.0, 1.0)(random_);
-  std::vector<double> noise(n, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t k = 0; k <= i; ++k) noise[i] += noise_factor_[i * n + k] * standard[k];
-    if (config_.noise.type == amytiss::NoiseType::Multiplicative) noise[i] *= std::abs(state[i]);
-  }
-  return noise;
+  return noise_.draw(state.data(), random_);
 }
 
 StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state) {

@@ -1,7 +1,8 @@
 #pragma once
 // A concrete stochastic plant for closed-loop simulation: x+ = f(x, u, w) + noise (additive) or
 // f(x, u, w) + noise * |x| (multiplicative, per component), with its own seeded random numbers.
-// The noise is drawn from the configuration's noise description in one place, draw_noise().
+// The noise is drawn from the configuration's noise description in one place, draw_noise(), by
+// amytiss::NoiseSampler: every law the synthesizer accepts.
 // The disturbance w, when the configuration has one, is drawn uniformly from its box each step
 // (the synthesis assumed the worst case, so a random one can only do better).
 #include <cstdint>
@@ -13,15 +14,15 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/model.hpp"
+#include "amytiss/noise_sampler.hpp"
 #include "amytiss/policy.hpp"
 
 namespace amytiss_ros {
 
 class PlantModel {
  public:
-  /// `config` passed validate() when its policy was computed. Throws ConfigError (from
-  /// make_dynamics, or key "noise.distribution" for a law it cannot draw yet: it draws normal
-  /// and uniform noise).
+  /// `config` passed validate() when its policy was computed. Throws ConfigError from
+  /// make_dynamics.
   PlantModel(const amytiss::Config& config, std::uint64_t seed);
 
   std::size_t state_dims() const { return state_dims_; }
@@ -36,7 +37,7 @@ class PlantModel {
   amytiss::Config config_;
   std::unique_ptr<amytiss::Dynamics> dynamics_;
   std::size_t state_dims_ = 0;
-  std::vector<double> noise_factor_;  // lower-triangular n*n (normal: Cholesky factor of the covariance)
+  amytiss::NoiseSampler noise_;
   std::mt19937_64 random_;
 };
 
