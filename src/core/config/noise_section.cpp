@@ -125,68 +125,68 @@ void check_law_noise(const NoiseConfig& noise, std::size_t n, const std::map<std
   }
 }
 
-}  // namespace
-
-void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::string, double>& constants) {
+void check_normal(const NoiseConfig& noise, std::size_t n) {
   const std::string n_text = std::to_string(n);
-  check_keys_of_distribution(noise);
-  if (noise.distribution == Distribution::Normal) {
-    const std::string example = n == 2 ? "covariance: [0.75, 0.75]" : "covariance: [" + n_text + " variances]";
-    const auto& c = noise.covariance;
-    if (c.size() != n && c.size() != n * n)
-      fail("noise.covariance", std::to_string(c.size()) + " values",
-           n_text + " values (diagonal) or " + std::to_string(n * n) + " values (full matrix, row-major)", example);
-    check_finite_list(c, "noise.covariance", example);
-    if (c.size() == n) {
-      for (std::size_t i = 0; i < n; ++i)
-        if (c[i] < 0)
-          fail(indexed("noise.covariance", i), format_number(c[i]),
-               "a variance >= 0 (0: no noise in that dimension)", example);
-    } else {
-      if (noise.type == NoiseType::Multiplicative)
-        throw ConfigError("noise.covariance",
-                          "a full covariance matrix with multiplicative noise is not supported; give the " + n_text +
-                              " diagonal variances (example: " + example + ")");
-      bool diagonal = true;
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t k = 0; k < n; ++k)
-          if (r != k && c[r * n + k] != 0.0) diagonal = false;
-      if (!diagonal && n > NoiseModel::kMaxFullCovarianceDims)
-        throw ConfigError("noise.covariance",
-                          "a full (non-diagonal) covariance is supported up to " +
-                              std::to_string(NoiseModel::kMaxFullCovarianceDims) + " state dimensions, got " + n_text +
-                              " (the quadrature cost grows like points^(n-1)); give the " + n_text +
-                              " diagonal variances (example: " + example + ")");
-      const auto entry = [&](std::size_t r, std::size_t k) { return c[r * n + k]; };
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t k = r + 1; k < n; ++k)
-          if (std::fabs(entry(r, k) - entry(k, r)) >
-              kSymmetryTolerance * std::max(1.0, std::max(std::fabs(entry(r, k)), std::fabs(entry(k, r)))))
-            throw ConfigError("noise.covariance",
-                              "got a matrix that is not symmetric: entry (" + std::to_string(r) + "," +
-                                  std::to_string(k) + ") = " + format_number(entry(r, k)) + " but (" +
-                                  std::to_string(k) + "," + std::to_string(r) + ") = " + format_number(entry(k, r)) +
-                                  "; expected a symmetric positive definite " + n_text + "x" + n_text +
-                                  " matrix, row-major");
-      // The same factorization the noise model computes its masses with.
-      if (!cholesky_factor(c, n))
-        throw ConfigError("noise.covariance", "got " + format_list(c) +
-                                                  ", which is not positive definite (Cholesky failed); expected a "
-                                                  "symmetric positive definite " + n_text + "x" + n_text +
-                                                  " matrix, row-major, or " + n_text + " positive variances");
-    }
-  } else if (noise.distribution == Distribution::Uniform) {
-    const std::string example = "half_width: [" + n_text + " positive numbers]";
-    if (noise.half_width.size() != n)
-      fail("noise.half_width", std::to_string(noise.half_width.size()) + " values", n_text + " values (one per state)",
-           example);
-    check_finite_list(noise.half_width, "noise.half_width", example);
+  const std::string example = n == 2 ? "covariance: [0.75, 0.75]" : "covariance: [" + n_text + " variances]";
+  const auto& c = noise.covariance;
+  if (c.size() != n && c.size() != n * n)
+    fail("noise.covariance", std::to_string(c.size()) + " values",
+         n_text + " values (diagonal) or " + std::to_string(n * n) + " values (full matrix, row-major)", example);
+  check_finite_list(c, "noise.covariance", example);
+  if (c.size() == n) {
     for (std::size_t i = 0; i < n; ++i)
-      if (noise.half_width[i] <= 0)
-        fail(indexed("noise.half_width", i), format_number(noise.half_width[i]), "a number > 0", example);
+      if (c[i] < 0)
+        fail(indexed("noise.covariance", i), format_number(c[i]),
+             "a variance >= 0 (0: no noise in that dimension)", example);
   } else {
-    check_law_noise(noise, n, constants);
+    if (noise.type == NoiseType::Multiplicative)
+      throw ConfigError("noise.covariance",
+                        "a full covariance matrix with multiplicative noise is not supported; give the " + n_text +
+                            " diagonal variances (example: " + example + ")");
+    bool diagonal = true;
+    for (std::size_t r = 0; r < n; ++r)
+      for (std::size_t k = 0; k < n; ++k)
+        if (r != k && c[r * n + k] != 0.0) diagonal = false;
+    if (!diagonal && n > NoiseModel::kMaxFullCovarianceDims)
+      throw ConfigError("noise.covariance",
+                        "a full (non-diagonal) covariance is supported up to " +
+                            std::to_string(NoiseModel::kMaxFullCovarianceDims) + " state dimensions, got " + n_text +
+                            " (the quadrature cost grows like points^(n-1)); give the " + n_text +
+                            " diagonal variances (example: " + example + ")");
+    const auto entry = [&](std::size_t r, std::size_t k) { return c[r * n + k]; };
+    for (std::size_t r = 0; r < n; ++r)
+      for (std::size_t k = r + 1; k < n; ++k)
+        if (std::fabs(entry(r, k) - entry(k, r)) >
+            kSymmetryTolerance * std::max(1.0, std::max(std::fabs(entry(r, k)), std::fabs(entry(k, r)))))
+          throw ConfigError("noise.covariance",
+                            "got a matrix that is not symmetric: entry (" + std::to_string(r) + "," +
+                                std::to_string(k) + ") = " + format_number(entry(r, k)) + " but (" +
+                                std::to_string(k) + "," + std::to_string(r) + ") = " + format_number(entry(k, r)) +
+                                "; expected a symmetric positive definite " + n_text + "x" + n_text +
+                                " matrix, row-major");
+    // The same factorization the noise model computes its masses with.
+    if (!cholesky_factor(c, n))
+      throw ConfigError("noise.covariance", "got " + format_list(c) +
+                                                ", which is not positive definite (Cholesky failed); expected a "
+                                                "symmetric positive definite " + n_text + "x" + n_text +
+                                                " matrix, row-major, or " + n_text + " positive variances");
   }
+}
+
+void check_uniform(const NoiseConfig& noise, std::size_t n) {
+  const std::string n_text = std::to_string(n);
+  const std::string example = "half_width: [" + n_text + " positive numbers]";
+  if (noise.half_width.size() != n)
+    fail("noise.half_width", std::to_string(noise.half_width.size()) + " values", n_text + " values (one per state)",
+         example);
+  check_finite_list(noise.half_width, "noise.half_width", example);
+  for (std::size_t i = 0; i < n; ++i)
+    if (noise.half_width[i] <= 0)
+      fail(indexed("noise.half_width", i), format_number(noise.half_width[i]), "a number > 0", example);
+}
+
+void check_truncation(const NoiseConfig& noise, std::size_t n) {
+  const std::string n_text = std::to_string(n);
   if (noise.cutting_probability && noise.truncation != Truncation::CuttingProbability)
     throw ConfigError("noise.cutting_probability", "given but noise.truncation is " + to_string(noise.truncation) +
                                                        "; set truncation: cutting_probability to use it");
@@ -206,6 +206,19 @@ void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::st
     throw ConfigError("noise.fixed_region", "given but noise.truncation is " + to_string(noise.truncation) +
                                                 "; set truncation: fixed_region to use it");
   }
+}
+
+}  // namespace
+
+void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::string, double>& constants) {
+  check_keys_of_distribution(noise);
+  if (noise.distribution == Distribution::Normal)
+    check_normal(noise, n);
+  else if (noise.distribution == Distribution::Uniform)
+    check_uniform(noise, n);
+  else
+    check_law_noise(noise, n, constants);
+  check_truncation(noise, n);
 }
 
 

@@ -132,18 +132,7 @@ void check_integrator(const IntegratorConfig& integrator, bool expressions, std:
                                         "; give `dynamics` as the discrete map without `integrator`");
 }
 
-}  // namespace
-
-void Config::validate() const {
-  if (name.empty()) fail("name", "\"\"", "a non-empty name", "name: robot_reach_avoid");
-
-  const double state_points = check_grid(states, "states", "");
-  const std::size_t n = states.lb.size();
-  const std::size_t m = inputs ? inputs->lb.size() : 0;
-  const std::size_t p = disturbances ? disturbances->lb.size() : 0;
-  if (inputs) check_grid(*inputs, "inputs", "; omit `inputs` for an autonomous system");
-  if (disturbances) check_grid(*disturbances, "disturbances", "; omit `disturbances` when there are none");
-
+void check_constants(const std::map<std::string, double>& constants) {
   for (const auto& constant : constants) {
     const std::string key = "constants." + constant.first;
     // z is the variable of noise densities.
@@ -155,39 +144,44 @@ void Config::validate() const {
                                  "(x0, u1, ..., z) or a function (example: constants: {tau: 10.0})");
     if (!std::isfinite(constant.second)) fail(key, format_number(constant.second), "a finite number", "tau: 10.0");
   }
+}
 
-  if (!model.empty() && !dynamics.empty())
+// Either expressions, one per state dimension, that parse; or a built-in model with its dimensions.
+void check_dynamics(const Config& config) {
+  const std::size_t n = config.states.lb.size();
+  const std::size_t m = config.inputs ? config.inputs->lb.size() : 0;
+  const std::size_t p = config.disturbances ? config.disturbances->lb.size() : 0;
+  if (!config.model.empty() && !config.dynamics.empty())
     throw ConfigError("model", "both `model` and `dynamics` are given; use one (example: model: bmw320i)");
-  if (model.empty()) {
-    if (dynamics.empty())
+  if (config.model.empty()) {
+    if (config.dynamics.empty())
       throw ConfigError("dynamics", "missing, expected one expression per state dimension or a built-in `model` "
                                     "(example: dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"])");
-    if (dynamics.size() != n)
-      fail("dynamics", std::to_string(dynamics.size()) + " expressions",
+    if (config.dynamics.size() != n)
+      fail("dynamics", std::to_string(config.dynamics.size()) + " expressions",
            std::to_string(n) + ", one per state dimension (states.lb has " + std::to_string(n) + " values)",
            "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]");
-    parse_dynamics(*this);
+    parse_dynamics(config);
   } else {
     const BuiltinModelInfo* info = nullptr;
     std::vector<std::string> names;
     for (const auto& candidate : builtin_models()) {
       names.push_back(candidate.name);
-      if (candidate.name == model) info = &candidate;
+      if (candidate.name == config.model) info = &candidate;
     }
-    if (!info) fail("model", "'" + model + "'", "one of " + join(names), "model: bmw320i");
+    if (!info) fail("model", "'" + config.model + "'", "one of " + join(names), "model: bmw320i");
     auto check_dims = [&](const char* key, std::size_t have, std::size_t want) {
       if (have != want)
-        throw ConfigError(key, "model " + model + " needs " + std::to_string(want) + " dimensions, got " +
+        throw ConfigError(key, "model " + config.model + " needs " + std::to_string(want) + " dimensions, got " +
                                    std::to_string(have) + " (" + info->description + ")");
     };
     check_dims("states.lb", n, info->state_dims);
     check_dims("inputs.lb", m, info->input_dims);
     check_dims("disturbances.lb", p, info->disturbance_dims);
   }
-  check_integrator(integrator, model.empty(), n);
+}
 
-  check_noise(noise, n, constants);
-
+void check_spec(const SpecConfig& spec, const GridSpec& states) {
   if (spec.unbounded) {
     const double tolerance = spec.tolerance_or_default();
     if (!(tolerance > 0 && tolerance < 1))
@@ -223,7 +217,9 @@ void Config::validate() const {
       }
       break;
   }
+}
 
+void check_compute(const ComputeConfig& compute) {
   if (!(compute.memory_fraction > 0 && compute.memory_fraction <= 1))
     fail("compute.memory_fraction", format_number(compute.memory_fraction), "a fraction in (0, 1]",
          "memory_fraction: 0.5");
@@ -245,7 +241,9 @@ void Config::validate() const {
   if (!compute.devices.empty() && compute.device == DeviceKind::Reference)
     fail("compute.devices", join(compute.devices), "no devices with compute.device: reference (it runs on the host)",
          "device: auto");
+}
 
+void check_policy_size(double state_points, const SpecConfig& spec) {
   // An unbounded policy is stored like one step (and its upper bound).
   const double stored_steps = spec.unbounded ? 2.0 : double(spec.horizon);
   const double policy_bytes = state_points * ((stored_steps + 1) * 8 + stored_steps * 4);
@@ -257,6 +255,22 @@ void Config::validate() const {
                   state_points, spec.horizon, spec.horizon, policy_bytes / (1024.0 * 1024 * 1024));
     throw ConfigError("states", text);
   }
+}
+
+}  // namespace
+
+void Config::validate() const {
+  if (name.empty()) fail("name", "\"\"", "a non-empty name", "name: robot_reach_avoid");
+  const double state_points = check_grid(states, "states", "");
+  if (inputs) check_grid(*inputs, "inputs", "; omit `inputs` for an autonomous system");
+  if (disturbances) check_grid(*disturbances, "disturbances", "; omit `disturbances` when there are none");
+  check_constants(constants);
+  check_dynamics(*this);
+  check_integrator(integrator, model.empty(), states.lb.size());
+  check_noise(noise, states.lb.size(), constants);
+  check_spec(spec, states);
+  check_compute(compute);
+  check_policy_size(state_points, spec);
 }
 
 }  // namespace amytiss
