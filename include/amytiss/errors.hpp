@@ -1,6 +1,9 @@
 #pragma once
-// Exceptions thrown by the amytiss core. The core never exits or logs-and-continues: every
-// failure is one of these, with a message meant for the user.
+// Exceptions thrown by the amytiss core for failures a user can meet, each with a message meant for
+// the user. The core never exits or logs-and-continues. Besides these: std::logic_error when an
+// invariant a validated configuration guarantees does not hold (a bug of the caller),
+// std::invalid_argument for an argument outside a utility's domain (normal_upper_quantile), and
+// ExportTooLarge (model_export.hpp) for a model export over its limit.
 #include <stdexcept>
 #include <string>
 

@@ -6,7 +6,8 @@
 // Input: the first byte picks the path; the rest is text.
 //   even: a dynamics expression over 2 states, 2 inputs, 1 disturbance and the constant `tau`,
 //         parsed, evaluated at a fixed point and emitted as C;
-//   odd:  a YAML configuration, read, validated, written back as canonical YAML and hashed.
+//   odd:  a YAML configuration, read (and written back), validated, written back as canonical
+//         YAML and hashed.
 // Refusals (ParseError, ConfigError, YAML::Exception) are the expected outcome of bad input; any
 // other exception, a crash or a sanitizer report is a finding.
 #include <cstddef>
@@ -34,7 +35,12 @@ inline void fuzz_one_input(const std::uint8_t* data, std::size_t size) {
       volatile std::size_t length = expression.to_c().size();
       (void)length;
     } else {
-      const Config config = config_from_yaml(YAML::Load(text));
+      // The reader alone first (it must take any value of the right type without judging it),
+      // then the one validation.
+      Config config = read_config(YAML::Load(text));
+      volatile std::size_t read_length = to_yaml(config).size();
+      (void)read_length;
+      config.validate();
       volatile std::size_t length = to_yaml(config).size() + config_hash(config).size();
       (void)length;
     }
