@@ -37,7 +37,7 @@ bool is_function_name(const std::string& name);
 /// `text` itself when short, else its first characters and its length: for error messages.
 std::string expression_excerpt(const std::string& text);
 
-struct ExpressionNode;  // defined in the .cpp
+struct ExpressionNode;  // model/expression_node.hpp (internal)
 struct ExpressionStep;  // expression_step.hpp
 
 /// Which components an expression reads: sorted, distinct indices of x, u and w.
