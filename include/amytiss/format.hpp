@@ -13,6 +13,9 @@ std::string format_number(double value);
 /// point nor an exponent ("10" -> "10.0"). Reads back to the same double.
 std::string c_double_literal(double value);
 
+/// A figure for people with `digits` significant digits, as printf's %g ("0.00032", "1.5e+07").
+std::string format_significant(double value, int digits = 3);
+
 /// Bytes for people: "512 B", "3.2 KiB", "1.5 MiB", "2.0 GiB" (binary units, one decimal).
 std::string format_bytes(double bytes);
 

@@ -2,7 +2,6 @@
 // and --dry-run all say the same thing.
 #include "plan.hpp"
 
-#include <cstdio>
 
 #include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
@@ -23,12 +22,6 @@ constexpr double kSerialMultiplyAdds = 3e7;
 // Unbounded specifications iterate until the bounds meet; the plan counts this many steps.
 constexpr double kPlannedUnboundedSteps = 100;
 
-std::string scientific(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
-
 void note(SynthesisPlan& plan, const std::string& text) {
   plan.notes.push_back({NoteSeverity::Info, NoteKind::DeviceChoice, text});
 }
@@ -37,15 +30,15 @@ void note(SynthesisPlan& plan, const std::string& text) {
 bool serial_pays(const Abstraction& a, SynthesisPlan& plan) {
   const double steps = a.unbounded ? kPlannedUnboundedSteps : double(a.horizon);
   const double total = plan.multiply_adds_per_step * steps;
-  const std::string work = "planned work " + scientific(plan.multiply_adds_per_step) + " multiply-adds per step, " +
-                           scientific(total) + " in all";
+  const std::string work = "planned work " + format_significant(plan.multiply_adds_per_step) + " multiply-adds per step, " +
+                           format_significant(total) + " in all";
   if (total <= kSerialMultiplyAdds) {
-    note(plan, "device auto: the serial reference engine (" + work + ", at most " + scientific(kSerialMultiplyAdds) +
+    note(plan, "device auto: the serial reference engine (" + work + ", at most " + format_significant(kSerialMultiplyAdds) +
                    ": building an OpenCL program would take longer than the synthesis)");
     return true;
   }
   note(plan, "device auto: an OpenCL device (" + work + ", above the serial engine's " +
-                 scientific(kSerialMultiplyAdds) + ")");
+                 format_significant(kSerialMultiplyAdds) + ")");
   return false;
 }
 

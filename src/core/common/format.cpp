@@ -34,6 +34,12 @@ std::uint64_t fnv1a64(const std::string& text, std::uint64_t basis) {
   return hash;
 }
 
+std::string format_significant(double value, int digits) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*g", digits, value);
+  return text;
+}
+
 std::string hex16(std::uint64_t value) {
   char buffer[17];
   std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(value));

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <random>
 #include <string>
 
@@ -113,9 +112,7 @@ ValueSummary summarize_initial_values(const Policy& policy) {
 std::string new_run_id() {
   std::random_device device;
   const std::uint64_t id = (std::uint64_t(device()) << 32) ^ std::uint64_t(device());
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(id));
-  return text;
+  return hex16(id);
 }
 
 }  // namespace amytiss

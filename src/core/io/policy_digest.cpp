@@ -1,7 +1,8 @@
 #include "io/policy_digest.hpp"
 
+#include "amytiss/format.hpp"
+
 #include <algorithm>
-#include <cstdio>
 #include <cstring>
 
 namespace amytiss::detail {
@@ -35,11 +36,7 @@ class ContentDigest {
     add(std::uint64_t(values.size()));
     for (Unsigned value : values) add(std::uint64_t(value));
   }
-  std::string hex() const {
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(state_));
-    return text;
-  }
+  std::string hex() const { return hex16(state_); }
 
  private:
   std::uint64_t state_ = 0xcbf29ce484222325ull;
