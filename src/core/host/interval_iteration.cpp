@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 
 #include "amytiss/stopwatch.hpp"
+#include "amytiss/format.hpp"
 #include "host/game_graph.hpp"
 
 namespace amytiss::detail {
@@ -34,12 +34,6 @@ constexpr double kGuessShare = 0.5;
 // Relative error allowed for the host's sums of non-negative mass * value terms (the masses'
 // own rounding and the summation's) when a guess is verified.
 constexpr double kMassRelativeError = 1e-12;
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
 
 double largest_gap(const std::vector<double>& lower, const std::vector<double>& upper) {
   double gap = 0;
@@ -187,72 +181,87 @@ struct Iteration {
   }
 };
 
-}  // namespace
+// What the graph analysis settled before the iteration: the lower bounds it starts from, and for
+// safety the cells that can stay safe surely with their inputs.
+struct GraphStart {
+  std::vector<double> initial_lower;
+  std::vector<char> sure_safe;
+  std::vector<std::uint32_t> sure_input;
+  std::size_t component_cells = 0;
+};
 
-Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& host, const UnboundedRun& run,
-                       SynthesisReport& report) {
+// Attractors: the value is exactly 0 outside the controller's positive attractor of the target,
+// and exactly 1 where it can stay safe surely; then the end components among the undecided cells.
+GraphStart analyse_graph(const Abstraction& a, GameSupports& supports, Iteration& it, SynthesisReport& report) {
   const std::size_t n = a.states.size();
-  const bool reach = a.spec != SpecType::Safety;
-  auto phase_start = Clock::now();
-  GameSupports supports(a);
-  Iteration it{a, supports, host, std::vector<char>(n, 0), std::vector<double>(n, 0.0), std::vector<double>(n, 0.0),
-               std::vector<std::uint32_t>(n, 0), std::vector<double>(n, -1.0)};
+  const auto start = Clock::now();
+  GraphStart graph;
+  graph.sure_safe.assign(n, 0);
   for (std::size_t x = 0; x < n; ++x) {
     it.lower[x] = a.roles[x] == CellRole::FixedOne ? 1.0 : 0.0;
     it.upper[x] = a.roles[x] == CellRole::FixedZero ? 0.0 : 1.0;
   }
-  // Attractors: the value is exactly 0 outside the controller's positive attractor of the target,
-  // and exactly 1 where it can stay safe surely.
-  std::vector<std::uint32_t> sure_input;
-  std::vector<char> sure_safe(n, 0);
-  if (reach) {
+  if (a.spec != SpecType::Safety) {
     const std::vector<char> attractor = positive_attractor(a, supports);
     for (std::size_t x = 0; x < n; ++x) {
       if (!attractor[x]) it.upper[x] = 0.0;
       it.candidate[x] = attractor[x] && a.roles[x] == CellRole::Free;
     }
   } else {
-    sure_safe = sure_safe_set(a, supports, sure_input);
+    graph.sure_safe = sure_safe_set(a, supports, graph.sure_input);
     for (std::size_t x = 0; x < n; ++x) {
-      if (sure_safe[x]) it.lower[x] = 1.0;
-      it.candidate[x] = !sure_safe[x] && a.roles[x] == CellRole::Free;
+      if (graph.sure_safe[x]) it.lower[x] = 1.0;
+      it.candidate[x] = !graph.sure_safe[x] && a.roles[x] == CellRole::Free;
     }
   }
-  const std::vector<double> initial_lower = it.lower;
+  graph.initial_lower = it.lower;
   auto every_input = [](std::size_t, std::size_t) { return true; };
   auto every_row = [](std::size_t, std::size_t, std::size_t) { return true; };
   const std::vector<std::int64_t> any_component = end_components(supports, n, it.candidate, every_input, every_row);
-  std::size_t component_cells = 0;
   for (std::size_t x = 0; x < n; ++x) {
     it.candidate[x] = any_component[x] >= 0;
-    component_cells += it.candidate[x];
+    graph.component_cells += it.candidate[x];
   }
-  report.phases.push_back({"graph analysis", seconds_since(phase_start), 0, 0});
+  report.phases.push_back({"graph analysis", seconds_since(start), 0, 0});
   report.notes.push_back(
       {NoteSeverity::Info, NoteKind::Convergence,
-       component_cells == 0 ? std::string("unbounded: no end components among the undecided cells (the play leaves "
-                                          "them with probability 1): plain interval iteration")
-                            : "unbounded: " + std::to_string(component_cells) +
-                                  " cells in end components, corrected on the host every " +
-                                  std::to_string(kCorrectionPeriod) + " iterations"});
+       graph.component_cells == 0
+           ? std::string("unbounded: no end components among the undecided cells (the play leaves "
+                         "them with probability 1): plain interval iteration")
+           : "unbounded: " + std::to_string(graph.component_cells) +
+                 " cells in end components, corrected on the host every " + std::to_string(kCorrectionPeriod) +
+                 " iterations"});
+  return graph;
+}
 
-  // --- interval iteration
-  phase_start = Clock::now();
-  std::vector<std::uint32_t> policy_input(n, 0), upper_input(n, 0);
-  std::vector<double> next(n);
+struct IterationOutcome {
   unsigned iterations = 0;
-  double gap = largest_gap(it.lower, it.upper);
-  std::vector<std::uint32_t> lower_input(n, 0);
+  double gap = 0;                          // largest upper - lower of the optimal value
+  std::vector<std::uint32_t> policy_input; // greedy for the lower bound
+};
+
+// Both sequences through `step` until their gap is within the iteration's share of the tolerance,
+// neither moves any more, or kMaxIterations.
+IterationOutcome iterate(const Abstraction& a, BellmanStep& step, Iteration& it, std::size_t component_cells,
+                         const UnboundedRun& run, SynthesisReport& report) {
+  const std::size_t n = a.states.size();
+  const bool reach = a.spec != SpecType::Safety;
+  const auto start = Clock::now();
+  IterationOutcome outcome;
+  outcome.policy_input.assign(n, 0);
+  std::vector<std::uint32_t> upper_input(n, 0), lower_input(n, 0);
+  std::vector<double> next(n);
+  outcome.gap = largest_gap(it.lower, it.upper);
   const double target = kIterationShareOfTolerance * a.tolerance;
   unsigned next_optimistic_try = kFirstOptimisticTry, optimistic_at = 0;
-  while (gap > target && iterations < kMaxIterations) {
+  while (outcome.gap > target && outcome.iterations < kMaxIterations) {
     bool moved = false;
     double lower_change = 0;
     step.apply(it.lower.data(), next.data(), lower_input.data());
     for (std::size_t x = 0; x < n; ++x) {
       // The input changes only when the lower bound grows by more than the step's rounding: an
       // input that is merely as good (a way to stay in an end component) makes no progress.
-      if (next[x] > it.lower[x] + step.resolution()) policy_input[x] = lower_input[x];
+      if (next[x] > it.lower[x] + step.resolution()) outcome.policy_input[x] = lower_input[x];
       if (next[x] > it.lower[x]) {
         lower_change = std::max(lower_change, next[x] - it.lower[x]);
         it.lower[x] = next[x];
@@ -262,52 +271,79 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
     step.apply(it.upper.data(), next.data(), upper_input.data());
     for (std::size_t x = 0; x < n; ++x)
       if (next[x] < it.upper[x]) it.upper[x] = next[x], moved = true;
-    ++iterations;
+    const unsigned iterations = ++outcome.iterations;
     if (component_cells > 0 && iterations % kCorrectionPeriod == 0)
       moved |= reach ? it.deflate_upper() : it.inflate_lower();
     if (reach && iterations >= next_optimistic_try && lower_change <= kSettledShare * target) {
       next_optimistic_try = 2 * iterations;
       if (it.optimistic_upper(kGuessShare * target)) optimistic_at = iterations, moved = true;
     }
-    gap = largest_gap(it.lower, it.upper);
-    if (run.on_iteration) run.on_iteration(iterations, gap);
+    outcome.gap = largest_gap(it.lower, it.upper);
+    if (run.on_iteration) run.on_iteration(iterations, outcome.gap);
     // Neither sequence moves (and the corrections found nothing): the gap cannot close.
     if (!moved && (component_cells == 0 || iterations % kCorrectionPeriod == 0)) break;
   }
-  report.phases.push_back({"interval iteration (" + std::to_string(iterations) + " iterations)",
-                           seconds_since(phase_start), 0, step.multiply_adds() * 2.0 * iterations});
+  report.phases.push_back({"interval iteration (" + std::to_string(outcome.iterations) + " iterations)",
+                           seconds_since(start), 0, step.multiply_adds() * 2.0 * outcome.iterations});
   if (optimistic_at > 0)
     report.notes.push_back({NoteSeverity::Info, NoteKind::Convergence,
-                            "unbounded: an optimistic upper bound (the lower bound + " + number(kGuessShare * target) +
-                                ") was verified (T(U) <= U) at iteration " + std::to_string(optimistic_at)});
+                            "unbounded: an optimistic upper bound (the lower bound + " +
+                                format_significant(kGuessShare * target) + ") was verified (T(U) <= U) at iteration " +
+                                std::to_string(optimistic_at)});
+  return outcome;
+}
 
-  // --- the stationary policy: greedy for the lower bound, the sure input where safety is sure,
-  // the component's input where a correction set the lower bound; its value from below.
-  phase_start = Clock::now();
+struct Certificate {
+  std::vector<double> values;  // the stationary policy's value from below
+  double gap = 0;              // largest upper bound - certified value
+};
+
+// The stationary policy (greedy for the lower bound, the sure input where safety is sure, the
+// component's input where a correction set the lower bound) and its value from below.
+Certificate certify(const Abstraction& a, ReferenceStep& host, const Iteration& it, const GraphStart& graph,
+                    IterationOutcome& outcome, SynthesisReport& report) {
+  const std::size_t n = a.states.size();
+  const auto start = Clock::now();
+  std::vector<std::uint32_t>& policy_input = outcome.policy_input;
   for (std::size_t x = 0; x < n; ++x) {
-    if (sure_safe[x]) policy_input[x] = sure_input[x];
+    if (graph.sure_safe[x]) policy_input[x] = graph.sure_input[x];
     else if (it.ec_value[x] >= 0 && it.lower[x] <= it.ec_value[x]) policy_input[x] = it.ec_input[x];
   }
-  std::vector<double> certified = initial_lower;
-  unsigned certification_steps = 0;
-  double certified_gap = largest_gap(certified, it.upper);
-  while (certified_gap > a.tolerance && certification_steps < 2 * iterations + 100) {
-    host.apply_fixed(certified.data(), next.data(), policy_input.data());
+  Certificate certificate{graph.initial_lower, 0};
+  std::vector<double> next(n);
+  unsigned steps = 0;
+  certificate.gap = largest_gap(certificate.values, it.upper);
+  while (certificate.gap > a.tolerance && steps < 2 * outcome.iterations + 100) {
+    host.apply_fixed(certificate.values.data(), next.data(), policy_input.data());
     bool moved = false;
     for (std::size_t x = 0; x < n; ++x)
-      if (next[x] > certified[x]) certified[x] = next[x], moved = true;
-    ++certification_steps;
-    certified_gap = largest_gap(certified, it.upper);
+      if (next[x] > certificate.values[x]) certificate.values[x] = next[x], moved = true;
+    ++steps;
+    certificate.gap = largest_gap(certificate.values, it.upper);
     if (!moved) break;
   }
-  report.phases.push_back({"policy certification (" + std::to_string(certification_steps) + " steps)",
-                           seconds_since(phase_start), 0, 0});
-  const std::string summary = "unbounded: " + std::to_string(iterations) + " iterations, upper - lower <= " +
-                              number(gap) + " for the optimal value; the stationary policy guarantees a value " +
-                              "within " + number(certified_gap) + " of the upper bound (tolerance " +
-                              number(a.tolerance) + ")";
-  report.notes.push_back({certified_gap <= a.tolerance ? NoteSeverity::Info : NoteSeverity::Warning, NoteKind::Convergence,
-                          certified_gap <= a.tolerance ? summary : summary + ": the tolerance was not reached"});
+  report.phases.push_back({"policy certification (" + std::to_string(steps) + " steps)", seconds_since(start), 0, 0});
+  const std::string summary = "unbounded: " + std::to_string(outcome.iterations) + " iterations, upper - lower <= " +
+                              format_significant(outcome.gap) + " for the optimal value; the stationary policy " +
+                              "guarantees a value within " + format_significant(certificate.gap) +
+                              " of the upper bound (tolerance " + format_significant(a.tolerance) + ")";
+  const bool converged = certificate.gap <= a.tolerance;
+  report.notes.push_back({converged ? NoteSeverity::Info : NoteSeverity::Warning, NoteKind::Convergence,
+                          converged ? summary : summary + ": the tolerance was not reached"});
+  return certificate;
+}
+
+}  // namespace
+
+Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& host, const UnboundedRun& run,
+                       SynthesisReport& report) {
+  const std::size_t n = a.states.size();
+  GameSupports supports(a);
+  Iteration it{a, supports, host, std::vector<char>(n, 0), std::vector<double>(n, 0.0), std::vector<double>(n, 0.0),
+               std::vector<std::uint32_t>(n, 0), std::vector<double>(n, -1.0)};
+  const GraphStart graph = analyse_graph(a, supports, it, report);
+  IterationOutcome outcome = iterate(a, step, it, graph.component_cells, run, report);
+  const Certificate certificate = certify(a, host, it, graph, outcome, report);
 
   Policy policy;
   policy.states = a.states;
@@ -317,13 +353,13 @@ Policy solve_unbounded(const Abstraction& a, BellmanStep& step, ReferenceStep& h
   policy.roles = a.roles;
   policy.computed_by = run.device_label;
   policy.config_hash = config_hash(a.config);
-  policy.values = certified;
-  policy.values.insert(policy.values.end(), certified.begin(), certified.end());
-  policy.input_index = policy_input;
+  policy.values = certificate.values;
+  policy.values.insert(policy.values.end(), certificate.values.begin(), certificate.values.end());
+  policy.input_index = outcome.policy_input;
   policy.upper_values = it.upper;
-  policy.iterations = iterations;
-  policy.gap = certified_gap;
-  policy.converged = certified_gap <= a.tolerance;
+  policy.iterations = outcome.iterations;
+  policy.gap = certificate.gap;
+  policy.converged = certificate.gap <= a.tolerance;
   return policy;
 }
 
