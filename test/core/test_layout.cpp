@@ -47,6 +47,43 @@ TEST(Layout, CoreHeadersSourcesAndCliIncludeNoRos) {
   }
 }
 
+// The core's folders by layer (docs/engine.md): an include may read its own layer or one below.
+int layer_of(const std::string& folder) {
+  static const std::vector<std::pair<std::string, int>> kLayers = {
+      {"common", 0}, {"model", 1},  {"config", 2},    {"host", 3},
+      {"io", 3},     {"opencl", 4}, {"scale_out", 5}, {"", 6}};  // "": src/core itself (plan, engine)
+  for (const auto& [name, layer] : kLayers)
+    if (folder == name) return layer;
+  return -1;
+}
+
+// The first folder of a path relative to src/core ("" for a file directly in src/core).
+std::string top_folder(const std::string& relative) {
+  const auto slash = relative.find('/');
+  return slash == std::string::npos ? std::string() : relative.substr(0, slash);
+}
+
+TEST(Layout, CoreIncludesReadDownTheLayers) {
+  const fs::path core = fs::path(AMYTISS_SOURCE_DIR) / "src/core";
+  const std::regex internal_include(R"re(^\s*#\s*include\s*"([a-z_]+/[^"]+)")re");
+  std::size_t checked = 0;
+  for (const auto& file : sources_under(core)) {
+    const std::string from = top_folder(fs::relative(file, core).generic_string());
+    ASSERT_GE(layer_of(from), 0) << file << " is in a folder without a layer: add it to kLayers";
+    std::ifstream input(file);
+    std::string line;
+    std::smatch match;
+    for (int number = 1; std::getline(input, line); ++number) {
+      if (!std::regex_search(line, match, internal_include) || match[1].str().rfind("amytiss/", 0) == 0) continue;
+      const std::string to = top_folder(match[1].str());
+      if (layer_of(to) < 0) continue;  // a file of the same folder named by a subfolder path
+      ++checked;
+      EXPECT_LE(layer_of(to), layer_of(from)) << file.string() << ":" << number << " reads up a layer: " << line;
+    }
+  }
+  EXPECT_GE(checked, 50u) << "too few internal includes found under " << core;
+}
+
 TEST(Layout, RosIncludePatternMatchesWhatItMustRefuse) {
   EXPECT_TRUE(std::regex_search("#include <ros/ros.h>", kRosInclude));
   EXPECT_TRUE(std::regex_search("  #include \"std_msgs/Float64.h\"", kRosInclude));
