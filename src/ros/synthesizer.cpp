@@ -244,6 +244,8 @@ void SynthesizerNode::synthesize_and_write(const amytiss::Config& config, const 
 
 void SynthesizerNode::announce(const amytiss::Config& config, const amytiss::Policy& policy, const Outcome& outcome,
                                const std::string& phase) {
+  // An unbounded run whose bounds did not meet says so wherever the policy is announced.
+  const std::string convergence = convergence_notice(policy);
   update_status([&](amytiss::PolicyStatus& status) {
     status.ready = true;
     status.synthesizing = false;
@@ -251,7 +253,7 @@ void SynthesizerNode::announce(const amytiss::Config& config, const amytiss::Pol
     status.phase = phase;
     status.device = policy.computed_by;
     status.remaining_s = 0.0;
-    status.message = outcome.message;
+    status.message = convergence.empty() ? outcome.message : outcome.message + "; " + convergence;
     status.config_name = config.name;
     status.config_hash = amytiss::config_hash(config);
     status.policy_file = outcome.policy_file;
