@@ -17,7 +17,7 @@
 #include <visualization_msgs/Marker.h>
 
 #include "amytiss/policy_file.hpp"
-#include "config_from_params.hpp"
+#include "amytiss/config.hpp"
 #include "conversions.hpp"
 #include "plant_model.hpp"
 #include "synthesizer.hpp"
@@ -90,9 +90,11 @@ std::string run_program(const std::vector<std::string>& arguments) {
                            : "killed by signal " + std::to_string(WTERMSIG(status));
 }
 
-/// The stored configuration of a policy file, as the plant needs it (dynamics, noise, spec, model).
+/// The stored configuration of a policy file, as the plant needs it (dynamics, noise, spec, model):
+/// read, not judged again (it was validated before the policy was computed, and the file's digest
+/// vouches for the text).
 amytiss::Config stored_configuration(const amytiss::LoadedPolicy& loaded) {
-  return config_from_yaml_text(loaded.config_yaml);
+  return amytiss::read_stored_config(loaded.config_yaml);
 }
 
 }  // namespace
