@@ -52,7 +52,7 @@ const EngineCase kEngines[] = {
 
 struct Problem {
   const char* name;
-  const char* yaml;
+  std::string yaml;
 };
 
 // Every problem runs on every sweep: dynamics expressions whose coordinates read few variables.
@@ -68,16 +68,7 @@ const Problem kProblems[] = {
      "noise: {type: additive, distribution: normal, covariance: [0.7, 0.7, 0.7],\n"
      "        truncation: cutting_probability, cutting_probability: 2.0e-2}\n"
      "spec: {type: safety, horizon: 4}\n"},
-    {"robot_disturbance",
-     "name: robot_small\n"
-     "states: {lb: [-10, -10], ub: [10, 10], eta: [1, 1]}\n"
-     "inputs: {lb: [-1, -1], ub: [1, 1], eta: [0.4, 0.4]}\n"
-     "disturbances: {lb: [-1], ub: [1], eta: [0.5]}\n"
-     "constants: {tau: 10.0}\n"
-     "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]\n"
-     "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
-     "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
-     "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n"},
+    {"robot_disturbance", test_support::robot_disturbance_yaml()},
     {"multiplicative",
      "name: multiplicative_small\n"
      "states: {lb: [-2, -2, -1], ub: [2, 2, 1], eta: [0.25, 0.25, 0.5]}\n"

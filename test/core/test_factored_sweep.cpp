@@ -27,6 +27,7 @@ constexpr double kMassTolerance = 1e-15;
 constexpr double kUnlimitedBudget = 1e12;
 
 using test_support::from_yaml;
+using test_support::robot_disturbance_yaml;
 
 // The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
 std::string traffic_yaml(double eta, unsigned horizon) {
@@ -40,18 +41,6 @@ std::string traffic_yaml(double eta, unsigned horizon) {
          "noise: {type: additive, distribution: normal, covariance: [0.7, 0.7, 0.7],\n"
          "        truncation: cutting_probability, cutting_probability: 2.0e-2}\n"
          "spec: {type: safety, horizon: " + std::to_string(horizon) + "}\n";
-}
-
-std::string robot_disturbance_yaml() {
-  return "name: robot_small\n"
-         "states: {lb: [-10, -10], ub: [10, 10], eta: [1, 1]}\n"
-         "inputs: {lb: [-1, -1], ub: [1, 1], eta: [0.4, 0.4]}\n"
-         "disturbances: {lb: [-1], ub: [1], eta: [0.5]}\n"
-         "constants: {tau: 10.0}\n"
-         "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]\n"
-         "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
-         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
-         "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
 }
 
 std::string multiplicative_yaml() {

@@ -211,5 +211,19 @@ inline Abstraction random_affine_abstraction(std::uint64_t seed, std::size_t sta
   return Abstraction::from_parts(config, dynamics);
 }
 
+/// The robot of config/robot_reach_avoid.yaml on a coarse grid with a disturbance w0 in both
+/// coordinates (the adversary's minimum matters), horizon 6.
+inline std::string robot_disturbance_yaml() {
+  return "name: robot_small\n"
+         "states: {lb: [-10, -10], ub: [10, 10], eta: [1, 1]}\n"
+         "inputs: {lb: [-1, -1], ub: [1, 1], eta: [0.4, 0.4]}\n"
+         "disturbances: {lb: [-1], ub: [1], eta: [0.5]}\n"
+         "constants: {tau: 10.0}\n"
+         "dynamics: [\"x0 + tau*u0*cos(u1) + w0\", \"x1 + tau*u0*sin(u1) + w0\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+         "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
+}
+
 }  // namespace test_support
 }  // namespace amytiss
