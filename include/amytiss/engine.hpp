@@ -17,8 +17,9 @@ namespace amytiss {
 /// `auto` takes the serial reference engine for problems whose planned work an OpenCL kernel
 /// build would dominate, else prefers a GPU, else the CPU OpenCL device; `cpu`/`gpu` are honoured
 /// or refused. A device that `auto` chose and that fails (DeviceError) is retried once on the CPU
-/// device, with a Warning DeviceFallback note. Throws Cancelled; ConfigError (a request that
-/// cannot be honoured, naming its key); DeviceError (no OpenCL device, or one that fails).
+/// device, with a Warning DeviceFallback note. Throws Cancelled; ConfigError (a configuration the
+/// engines cannot run, naming its key); DeviceError (a device request this machine cannot honour,
+/// its message starting with the key; no OpenCL device; or a device that fails).
 Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& options,
                   SynthesisReport* report = nullptr);
 

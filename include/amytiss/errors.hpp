@@ -42,7 +42,9 @@ class PolicyFileError : public std::runtime_error {
 };
 
 /// An OpenCL device could not be found, set up, or failed while running (kernel build errors
-/// carry the compiler's log).
+/// carry the compiler's log), or a device request cannot be honoured on this machine (absent
+/// kind, unmatched selection, stored transitions that do not fit: the message starts with the
+/// key, e.g. "compute.device: got gpu, but ...", and names the devices present).
 class DeviceError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

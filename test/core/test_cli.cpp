@@ -125,12 +125,12 @@ TEST_F(CliTest, MissingConfigurationFileExitsTwo) {
   EXPECT_CONTAINS(result.err, "absent.yaml");
 }
 
-// A request the machine cannot honour is refused like a bad configuration value (exit 2).
-TEST_F(CliTest, AnAbsentDeviceKindExitsTwoNamingTheDevices) {
+// A device request the machine cannot honour is refused with exit status 1, naming the devices.
+TEST_F(CliTest, AnAbsentDeviceKindExitsOneNamingTheDevices) {
   const CommandResult devices = synth("--list-devices");
   if (devices.out.find("(GPU") != std::string::npos) GTEST_SKIP() << "a GPU is present";
   const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device gpu --quiet");
-  EXPECT_EQ(2, result.exit_code);
+  EXPECT_EQ(1, result.exit_code);
   EXPECT_CONTAINS(result.err, "compute.device: got gpu, but no OpenCL gpu device");
   EXPECT_CONTAINS(result.err, "devices present");
 }

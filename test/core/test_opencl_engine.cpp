@@ -352,14 +352,13 @@ TEST(OpenClEngine, StoredRequestThatDoesNotFitIsRefusedNotReplaced) {
   options.compute.memory_fraction = 1e-6;  // a few KiB: the records cannot fit
   try {
     detail::synthesize_opencl(a, options, nullptr);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& error) {
-    EXPECT_EQ(error.key(), "compute.transitions");
-    EXPECT_NE(std::string(error.what()).find("got stored, but the records do not fit"), std::string::npos)
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("compute.transitions: got stored, but the records do not fit", 0), 0u)
         << error.what();
   }
   // Not retried elsewhere either: the request is the user's.
-  EXPECT_THROW(synthesize(a, options), ConfigError);
+  EXPECT_THROW(synthesize(a, options), DeviceError);
 }
 
 TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
@@ -432,10 +431,10 @@ TEST(OpenClEngine, ExplicitRequestForAnAbsentDeviceKindFailsNamingTheDevicesPres
   options.compute.device = ask_gpu ? DeviceKind::Gpu : DeviceKind::Cpu;
   try {
     synthesize(a, options);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& error) {
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
     const std::string message = error.what();
-    EXPECT_EQ(error.key(), "compute.device");
+    EXPECT_EQ(message.rfind("compute.device: ", 0), 0u) << message;
     EXPECT_NE(message.find(std::string("got ") + (ask_gpu ? "gpu" : "cpu") + ", but no OpenCL"), std::string::npos)
         << message;
     EXPECT_NE(message.find("devices present"), std::string::npos) << message;
@@ -443,17 +442,17 @@ TEST(OpenClEngine, ExplicitRequestForAnAbsentDeviceKindFailsNamingTheDevicesPres
   }
 }
 
-// A selection that matches nothing is a request refused (ConfigError naming its key), like every
-// other refused request; DeviceError is kept for devices that are missing altogether or fail.
+// A selection that matches nothing is a device request refused: DeviceError (exit status 1) naming
+// its key, like an absent device kind.
 TEST(OpenClEngine, UnknownDeviceSelectionIsARefusedRequest) {
   const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.2, 2));
   SynthesisOptions options = cpu_options();
   options.compute.platform = "no-such-platform-name";
   try {
     synthesize(a, options);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& error) {
-    EXPECT_EQ(error.key(), "compute.platform");
+    FAIL() << "expected DeviceError";
+  } catch (const DeviceError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("compute.platform: ", 0), 0u) << error.what();
   }
 }
 

@@ -220,7 +220,7 @@ TEST(SubDevices, RecordsThatExceedOneDeviceAreStoredAcrossTwo) {
   stored.compute.transitions = TransitionStorage::Stored;
   stored.compute.memory_fraction = fraction;
   SynthesisReport refused;
-  EXPECT_THROW(detail::synthesize_opencl(a, stored, &refused), ConfigError);
+  EXPECT_THROW(detail::synthesize_opencl(a, stored, &refused), DeviceError);
   stored.compute.devices = kParts;
   SynthesisReport report;
   const Policy many = detail::synthesize_opencl(a, stored, &report);

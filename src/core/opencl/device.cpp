@@ -142,8 +142,8 @@ DeviceInfo select_device(const std::vector<DeviceInfo>& usable, const DeviceSele
   for (const DeviceInfo& info : usable)
     present += "\n  [" + std::to_string(info.platform_index) + "." + std::to_string(info.device_index) + "] " +
                info.label() + " (" + info.type_name() + ")";
-  throw ConfigError("compute.devices", "entry '" + text + "' matches no OpenCL device with double precision (example: "
-                                       "devices: [cpu:0]); devices:" + (present.empty() ? std::string(" none") : present));
+  throw DeviceError("compute.devices: entry '" + text + "' matches no OpenCL device with double precision (example: "
+                    "devices: [cpu:0]); devices:" + (present.empty() ? std::string(" none") : present));
 }
 
 DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& notes) {
@@ -161,8 +161,8 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
     throw DeviceError("no OpenCL device with double precision found (amytiss_synth --list-devices shows the devices); "
                       "use compute.device: reference");
   if (candidates.empty())
-    throw ConfigError(compute.platform.empty() ? "compute.device_name" : "compute.platform",
-                      "no OpenCL device with double precision matches compute.platform '" + compute.platform +
+    throw DeviceError(std::string(compute.platform.empty() ? "compute.device_name" : "compute.platform") +
+                      ": no OpenCL device with double precision matches compute.platform '" + compute.platform +
                           "' and compute.device_name '" + compute.device_name +
                           "' (example: platform: 0; amytiss_synth --list-devices shows the devices)");
   auto first_of = [&](bool gpu) -> const DeviceInfo* {
@@ -173,12 +173,11 @@ DeviceInfo choose_device(const ComputeConfig& compute, std::vector<EngineNote>& 
   const DeviceInfo* gpu = first_of(true);
   const DeviceInfo* cpu = first_of(false);
   // An explicit kind is honoured or refused, never replaced by another device.
-  auto refuse = [&](const std::string& kind) -> ConfigError {
+  auto refuse = [&](const std::string& kind) -> DeviceError {
     std::string present;
     for (const DeviceInfo& info : all) present += "\n  " + info.label() + " (" + info.type_name() + ")";
-    return ConfigError("compute.device", "got " + kind + ", but no OpenCL " + kind +
-                                             " device with double precision matches (example: device: auto); "
-                                             "devices present:" + present);
+    return DeviceError("compute.device: got " + kind + ", but no OpenCL " + kind +
+                       " device with double precision matches (example: device: auto); devices present:" + present);
   };
   switch (compute.device) {
     case DeviceKind::Gpu:

@@ -57,9 +57,8 @@ RunPlan plan_run(const Abstraction& a, const Layout& layout, const DeviceInfo& d
     case TransitionStorage::Stored:
       // An explicit request is honoured or refused, never silently replaced.
       if (!fits)
-        throw ConfigError("compute.transitions", "got stored, but the records do not fit on " + device.label() +
-                                                     ": " + estimate +
-                                                     " (example: transitions: auto, or a larger memory_fraction)");
+        throw DeviceError("compute.transitions: got stored, but the records do not fit on " + device.label() + ": " +
+                          estimate + " (example: transitions: auto, or a larger memory_fraction)");
       rep.transitions = "stored (requested; " + estimate + ")";
       break;
     default:

@@ -19,9 +19,9 @@ std::vector<TeamDevice> split_device(const DeviceInfo& parent, unsigned units, c
   cl_uint count = 0;
   cl_int error = clCreateSubDevices(parent.device, properties, 0, nullptr, &count);
   if (error != CL_SUCCESS || count == 0)
-    throw ConfigError("compute.devices", "entry '" + text + "': " + parent.label() + " cannot be split into parts of " +
-                                         std::to_string(units) + " compute units (clCreateSubDevices: " +
-                                         cl_error_name(error) + "; example: cpu:0/1)");
+    throw DeviceError("compute.devices: entry '" + text + "': " + parent.label() + " cannot be split into parts of " +
+                      std::to_string(units) + " compute units (clCreateSubDevices: " + cl_error_name(error) +
+                      "; example: cpu:0/1)");
   std::vector<cl_device_id> ids(count);
   check(clCreateSubDevices(parent.device, properties, count, ids.data(), nullptr), "clCreateSubDevices");
   // The sub-devices are not released: pocl's worker threads may still release the last events of
