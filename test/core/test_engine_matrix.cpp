@@ -57,17 +57,8 @@ struct Problem {
 
 // Every problem runs on every sweep: dynamics expressions whose coordinates read few variables.
 const Problem kProblems[] = {
-    // The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
-    {"traffic",
-     "name: traffic_small\n"
-     "states: {lb: [0, 0, 0], ub: [8, 8, 8], eta: [0.4, 0.4, 0.4]}\n"
-     "inputs: {lb: [0, 0], ub: [1, 1], eta: [1, 1]}\n"
-     "constants: {flow: 0.36, q: 0.5, entry1: 6.0, entry3: 8.0}\n"
-     "dynamics: [\"(1 - flow)*x0 + flow*x2 + entry1*u0\", \"(1 - flow - q)*x1 + flow*x0\",\n"
-     "           \"(1 - flow)*x2 + flow*x1 + entry3*u1\"]\n"
-     "noise: {type: additive, distribution: normal, covariance: [0.7, 0.7, 0.7],\n"
-     "        truncation: cutting_probability, cutting_probability: 2.0e-2}\n"
-     "spec: {type: safety, horizon: 4}\n"},
+    // The 3-d traffic ring on a coarser grid: few inputs, wide windows.
+    {"traffic", test_support::traffic_yaml(0.4, 4)},
     {"robot_disturbance", test_support::robot_disturbance_yaml()},
     {"multiplicative",
      "name: multiplicative_small\n"

@@ -211,6 +211,20 @@ inline Abstraction random_affine_abstraction(std::uint64_t seed, std::size_t sta
   return Abstraction::from_parts(config, dynamics);
 }
 
+/// The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
+inline std::string traffic_yaml(double eta, unsigned horizon) {
+  const std::string e = std::to_string(eta);
+  return "name: traffic_small\n"
+         "states: {lb: [0, 0, 0], ub: [8, 8, 8], eta: [" + e + ", " + e + ", " + e + "]}\n"
+         "inputs: {lb: [0, 0], ub: [1, 1], eta: [1, 1]}\n"
+         "constants: {flow: 0.36, q: 0.5, entry1: 6.0, entry3: 8.0}\n"
+         "dynamics: [\"(1 - flow)*x0 + flow*x2 + entry1*u0\", \"(1 - flow - q)*x1 + flow*x0\",\n"
+         "           \"(1 - flow)*x2 + flow*x1 + entry3*u1\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.7, 0.7, 0.7],\n"
+         "        truncation: cutting_probability, cutting_probability: 2.0e-2}\n"
+         "spec: {type: safety, horizon: " + std::to_string(horizon) + "}\n";
+}
+
 /// The robot of config/robot_reach_avoid.yaml on a coarse grid with a disturbance w0 in both
 /// coordinates (the adversary's minimum matters), horizon 6.
 inline std::string robot_disturbance_yaml() {
