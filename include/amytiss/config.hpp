@@ -77,6 +77,11 @@ struct IntegratorConfig {
 
 enum class SpecType { Safety, Reachability, ReachAvoid };
 
+/// What the values guarantee (docs/semantics.md): `abstraction`, exact values of the finite MDP built
+/// from the cells' points; `system`, a lower and an upper bound of the probability for the
+/// continuous system from every state of a cell, through the interval MDP of the cells.
+enum class Guarantee { Abstraction, System };
+
 struct SpecConfig {
   SpecType type = SpecType::Safety;
   unsigned horizon = 0;       ///< T_d, number of steps, >= 1 (0 when unbounded)
@@ -142,6 +147,7 @@ struct Config {
   IntegratorConfig integrator;
   NoiseConfig noise;
   SpecConfig spec;
+  Guarantee guarantee = Guarantee::Abstraction;
   ComputeConfig compute;
 
   /// The only place that judges user input (docs/configuration.md, "Checks"). Throws
@@ -200,5 +206,6 @@ std::string to_string(NoiseType);
 std::string to_string(Distribution);
 std::string to_string(Truncation);
 std::string to_string(IntegrationMethod);
+std::string to_string(Guarantee);
 
 }  // namespace amytiss

@@ -24,12 +24,24 @@ struct Policy {
   /// hold input 0.
   std::vector<std::uint32_t> input_index;
   std::vector<CellRole> roles;
+  /// What `values` and `upper_values` bound (docs/semantics.md). Abstraction: `values` are the
+  /// finite MDP's exact values (bounded horizon; `upper_values` empty). System: `values` are lower
+  /// bounds of the continuous system's probability under this policy from every state of the cell,
+  /// `upper_values` (same layout as `values`, or one row when stationary) upper bounds of what any
+  /// controller choosing inputs of the input grid achieves.
+  Guarantee guarantee = Guarantee::Abstraction;
   /// Unbounded specification (horizon: infinite): the policy is stationary, `horizon` is 1,
   /// values rows 0 and 1 both hold the certified lower bound (the probability the stored
   /// policy guarantees), `upper_values` the upper bound of the optimal value per cell, and
   /// lookup() ignores the step.
   bool stationary = false;
   std::vector<double> upper_values;
+  /// The upper bound that matches value(step, cell): upper_values' row `step` (stationary: its
+  /// only row); value(step, cell) itself when there is no upper bound (abstraction, bounded).
+  double upper_value(unsigned step, std::size_t cell) const {
+    if (upper_values.empty()) return value(step, cell);
+    return stationary ? upper_values[cell] : upper_values[std::size_t(step) * states.size() + cell];
+  }
   unsigned iterations = 0;  ///< interval iterations done (stationary only)
   double gap = 0;           ///< max over cells of upper - lower (stationary only)
   /// Stationary only: whether `gap` reached the specification's tolerance. False: the bounds
@@ -49,10 +61,10 @@ struct Policy {
 
   /// Concrete state -> input and probability for time step `step` (0 <= step < horizon; any step
   /// for a stationary policy).
-  /// Writes inputs.dims() values to input_out and V_step(cell) to probability_out on Ok. No
-  /// allocation, O(dimension).
+  /// Writes inputs.dims() values to input_out and V_step(cell) to probability_out on Ok, and
+  /// upper_value(step, cell) to upper_out when it is not null. No allocation, O(dimension).
   LookupStatus lookup(const double* state, std::size_t state_length, unsigned step,
-                      double* input_out, double* probability_out) const;
+                      double* input_out, double* probability_out, double* upper_out = nullptr) const;
   /// A sentence that says what was wrong and what was expected, e.g. "state has 3 values,
   /// expected 2 (x0, x1)" or "state [12, 0] is outside the grid [-10.25, 10.25] x [...]".
   std::string describe(LookupStatus status, const double* state, std::size_t state_length,

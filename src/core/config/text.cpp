@@ -79,6 +79,8 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   if (config.spec.safe) text += "  safe: " + box_yaml(*config.spec.safe) + "\n";
   if (config.spec.target) text += "  target: " + box_yaml(*config.spec.target) + "\n";
   if (config.spec.avoid) text += "  avoid: " + box_yaml(*config.spec.avoid) + "\n";
+  // Left out when it is the default, so configurations without the key keep their text and hash.
+  if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
   if (with_compute) {
     const ComputeConfig& compute = config.compute;
     text += "compute:\n";

@@ -243,16 +243,41 @@ void check_compute(const ComputeConfig& compute) {
          "device: auto");
 }
 
-void check_policy_size(double state_points, const SpecConfig& spec) {
-  // An unbounded policy is stored like one step (and its upper bound).
+// The continuous-system bounds are products of one-dimensional masses, computed on the host.
+void check_guarantee(const Config& config) {
+  if (config.guarantee != Guarantee::System) return;
+  const std::size_t n = config.states.lb.size();
+  const std::vector<double>& covariance = config.noise.covariance;
+  if (covariance.size() == n * n && n > 1)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j)
+        if (i != j && covariance[i * n + j] != 0.0)
+          fail("noise.covariance", "a full matrix (entry [" + std::to_string(i) + "][" + std::to_string(j) +
+                                       "] = " + format_number(covariance[i * n + j]) + ")",
+               "a diagonal covariance with guarantee: system (its transition bounds are products of "
+               "one-dimensional masses)",
+               "covariance: [0.75, 0.75]");
+  if (config.compute.device == DeviceKind::Cpu || config.compute.device == DeviceKind::Gpu)
+    fail("compute.device", to_string(config.compute.device),
+         "auto or reference with guarantee: system (its interval bounds are computed on the host's cores)",
+         "device: auto");
+  if (!config.compute.devices.empty())
+    fail("compute.devices", join(config.compute.devices),
+         "no devices with guarantee: system (its interval bounds are computed on the host's cores)", "device: auto");
+}
+
+void check_policy_size(double state_points, const SpecConfig& spec, bool system_bounds) {
+  // An unbounded policy is stored like one step (and its upper bound); continuous-system bounds
+  // store an upper bound beside every value.
   const double stored_steps = spec.unbounded ? 2.0 : double(spec.horizon);
-  const double policy_bytes = state_points * ((stored_steps + 1) * 8 + stored_steps * 4);
+  const double value_bytes = system_bounds && !spec.unbounded ? 16 : 8;
+  const double policy_bytes = state_points * ((stored_steps + 1) * value_bytes + stored_steps * 4);
   if (policy_bytes > kMaxPolicyBytes) {
     char text[300];
     std::snprintf(text, sizeof text,
-                  "grid too large: %.0f states x (%u+1 values x 8 bytes + %u inputs x 4 bytes) = %.1f GiB of "
+                  "grid too large: %.0f states x (%u+1 values x %.0f bytes + %u inputs x 4 bytes) = %.1f GiB of "
                   "policy arrays, more than the 16 GiB supported; use a larger states.eta or a shorter horizon",
-                  state_points, spec.horizon, spec.horizon, policy_bytes / (1024.0 * 1024 * 1024));
+                  state_points, spec.horizon, value_bytes, spec.horizon, policy_bytes / (1024.0 * 1024 * 1024));
     throw ConfigError("states", text);
   }
 }
@@ -270,7 +295,8 @@ void Config::validate() const {
   check_noise(noise, states.lb.size(), constants);
   check_spec(spec, states);
   check_compute(compute);
-  check_policy_size(state_points, spec);
+  check_guarantee(*this);
+  check_policy_size(state_points, spec, guarantee == Guarantee::System);
 }
 
 }  // namespace amytiss

@@ -229,7 +229,7 @@ YAML::Node parse_yaml_text(const std::string& text, const std::string& key) {
 Config read_config(const YAML::Node& root) {
   const char* const name_example = "name: robot_reach_avoid";
   check_keys(root, "", {"name", "states", "inputs", "disturbances", "constants", "dynamics", "model", "integrator",
-                        "noise", "spec", "compute"},
+                        "noise", "spec", "guarantee", "compute"},
              name_example);
   Config config;
   config.name = read_string(required(root, "name", "name", name_example), "name", name_example);
@@ -247,6 +247,8 @@ Config read_config(const YAML::Node& root) {
   if (present(root["integrator"])) config.integrator = read_integrator(root["integrator"]);
   config.noise = read_noise(required(root, "noise", "noise", "noise: {covariance: [0.75, 0.75]}"));
   config.spec = read_spec(required(root, "spec", "spec", "spec: {type: safety, horizon: 8}"));
+  if (present(root["guarantee"]))
+    config.guarantee = read_enum<Guarantee>(root["guarantee"], "guarantee", "guarantee: system");
   if (present(root["compute"])) config.compute = read_compute(root["compute"]);
   return config;
 }

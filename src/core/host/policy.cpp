@@ -35,7 +35,7 @@ std::string covered_interval(const Grid& grid, std::size_t d) {
 }  // namespace
 
 LookupStatus Policy::lookup(const double* state, std::size_t state_length, unsigned step,
-                            double* input_out, double* probability_out) const {
+                            double* input_out, double* probability_out, double* upper_out) const {
   if (state_length != states.dims()) return LookupStatus::WrongDimension;
   for (std::size_t i = 0; i < state_length; ++i)
     if (!std::isfinite(state[i])) return LookupStatus::NotFinite;
@@ -45,6 +45,7 @@ LookupStatus Policy::lookup(const double* state, std::size_t state_length, unsig
   if (!cell) return LookupStatus::OutsideGrid;
   inputs.point(input(step, *cell), input_out);
   *probability_out = value(step, *cell);
+  if (upper_out) *upper_out = upper_value(step, *cell);
   return LookupStatus::Ok;
 }
 

@@ -57,6 +57,8 @@ void add_attributes(ContentDigest& digest, const PolicyFileAttributes& attribute
     digest.add(attributes.iterations);
     digest.add(attributes.converged);
   }
+  // Present only in files of continuous-system bounds: other files keep their digest.
+  if (!attributes.guarantee.empty()) digest.add(attributes.guarantee);
 }
 
 void add_grid(ContentDigest& digest, const Grid& grid) {
@@ -86,7 +88,7 @@ std::string policy_digest(const PolicyFileAttributes& attributes, const std::str
   std::vector<std::uint8_t> roles(policy.roles.size());
   for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = std::uint8_t(policy.roles[i]);
   digest.add(roles);
-  if (policy.stationary) digest.add(policy.upper_values);
+  if (policy.stationary || policy.guarantee == Guarantee::System) digest.add(policy.upper_values);
   return digest.hex();
 }
 

@@ -17,6 +17,7 @@ struct PolicyFileAttributes {
   std::uint64_t engine_version = 0, horizon = 0;
   std::string spec;
   std::uint64_t stationary = 0, iterations = 0, converged = 0;  ///< unbounded specifications only
+  std::string guarantee;  ///< "system" for continuous-system bounds; empty (not written) otherwise
 };
 
 /// The input grid's points, row i = input i (the /input_values dataset).

@@ -23,6 +23,11 @@ std::vector<hsize_t> per_cell_shape(const Grid& states) {
   return shape;
 }
 
+// Stationary: one upper bound per cell; bounded horizons: one per value.
+std::vector<hsize_t> upper_values_shape(const Policy& policy) {
+  return policy.stationary ? per_cell_shape(policy.states) : cell_shape(policy.states, policy.horizon + 1);
+}
+
 void write_grid(const Hdf5Writer& writer, const std::string& group_name, const Grid& grid) {
   writer.group(group_name);
   const std::vector<hsize_t> shape{hsize_t(grid.dims())};
@@ -46,6 +51,7 @@ void write_attributes(const Hdf5Writer& writer, const PolicyFileAttributes& attr
     writer.unsigned_attribute("iterations", attributes.iterations);
     writer.unsigned_attribute("converged", attributes.converged);
   }
+  if (!attributes.guarantee.empty()) writer.string_attribute("guarantee", attributes.guarantee);
   writer.string_attribute("content_digest", digest);
 }
 
@@ -106,6 +112,12 @@ PolicyFileAttributes read_attributes(const Hdf5Reader& reader, Policy& policy) {
       reader.fail("converged is " + std::to_string(attributes.converged) + ", expected 0 or 1");
     policy.converged = attributes.converged == 1;
   }
+  if (reader.has_attribute("guarantee")) {
+    attributes.guarantee = reader.string_attribute("guarantee");
+    if (attributes.guarantee != to_string(Guarantee::System))
+      reader.fail("guarantee is '" + attributes.guarantee + "', expected 'system' (or no attribute: abstraction)");
+    policy.guarantee = Guarantee::System;
+  }
   return attributes;
 }
 
@@ -146,12 +158,13 @@ void read_cell_arrays(const Hdf5Reader& reader, Policy& policy) {
                   ", expected 0 (free), 1 (fixed zero) or 2 (fixed one)");
     policy.roles.push_back(CellRole(roles[i]));
   }
-  if (!policy.stationary) return;
+  if (!policy.stationary && policy.guarantee != Guarantee::System) return;
   policy.upper_values = reader.numeric_dataset<double>("/upper_values", H5T_FLOAT, H5T_NATIVE_DOUBLE,
-                                                       per_cell_shape(policy.states));
+                                                       upper_values_shape(policy));
   check_probabilities(reader, "/upper_values", policy.upper_values);
-  for (std::size_t i = 0; i < policy.upper_values.size(); ++i)
-    policy.gap = std::max(policy.gap, policy.upper_values[i] - policy.values[i]);
+  if (policy.stationary)
+    for (std::size_t i = 0; i < policy.upper_values.size(); ++i)
+      policy.gap = std::max(policy.gap, policy.upper_values[i] - policy.values[i]);
 }
 
 }  // namespace
@@ -173,6 +186,12 @@ void check_policy_consistent(const Policy& policy) {
     throw PolicyFileError("cannot write a stationary policy with horizon " + std::to_string(policy.horizon) +
                           " and " + std::to_string(policy.upper_values.size()) +
                           " upper bounds: expected horizon 1 and " + std::to_string(cells));
+  if (!policy.stationary && policy.guarantee == Guarantee::System && policy.upper_values.size() != policy.values.size())
+    throw PolicyFileError("cannot write continuous-system bounds with " + std::to_string(policy.upper_values.size()) +
+                          " upper bounds: expected one per value, " + std::to_string(policy.values.size()));
+  if (!policy.stationary && policy.guarantee == Guarantee::Abstraction && !policy.upper_values.empty())
+    throw PolicyFileError("cannot write abstraction values with upper bounds (only unbounded specifications and "
+                          "guarantee: system have them)");
 }
 
 void check_policy_values(const Policy& policy) {
@@ -206,6 +225,7 @@ void write_policy_contents(const Hdf5Writer& writer, const Policy& policy, const
   attributes.stationary = policy.stationary ? 1 : 0;
   attributes.iterations = policy.stationary ? policy.iterations : 0;
   attributes.converged = policy.stationary && policy.converged ? 1 : 0;
+  if (policy.guarantee == Guarantee::System) attributes.guarantee = to_string(Guarantee::System);
   const std::string config_yaml = to_yaml(config);
 
   write_attributes(writer, attributes, policy_digest(attributes, config_yaml, policy));
@@ -221,8 +241,8 @@ void write_policy_contents(const Hdf5Writer& writer, const Policy& policy, const
                  H5T_NATIVE_DOUBLE, input_values.data());
   static_assert(sizeof(CellRole) == sizeof(std::uint8_t), "roles are stored as uint8");
   writer.dataset("/roles", per_cell_shape(policy.states), H5T_STD_U8LE, H5T_NATIVE_UINT8, policy.roles.data());
-  if (policy.stationary)
-    writer.dataset("/upper_values", per_cell_shape(policy.states), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+  if (policy.stationary || policy.guarantee == Guarantee::System)
+    writer.dataset("/upper_values", upper_values_shape(policy), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                    policy.upper_values.data());
 }
 
