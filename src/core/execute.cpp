@@ -3,6 +3,7 @@
 #include "amytiss/errors.hpp"
 #include "host/backward_driver.hpp"
 #include "host/reference_engine.hpp"
+#include "host/system_engine.hpp"
 #include "opencl/engine.hpp"
 #include "scale_out/team_dense.hpp"
 #include "scale_out/team_factored.hpp"
@@ -29,6 +30,7 @@ Policy carry_out(const Abstraction& a, SynthesisPlan& plan, const SynthesisOptio
   report.notes.insert(report.notes.end(), plan.notes.begin(), plan.notes.end());
   if (plan.engine == EngineKind::Reference) return run_reference(a, options.progress, report);
   StepReporter reporter(a, options.progress, report);
+  if (plan.engine == EngineKind::Bounds) return run_system_bounds(a, plan.bounds_set, reporter);
   if (plan.engine == EngineKind::Team) return run_team(a, plan, options, engine_options, reporter);
   return run_on_device(a, plan.device, plan.factored, options, engine_options, reporter);
 }

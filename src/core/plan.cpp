@@ -42,6 +42,21 @@ bool serial_pays(const Abstraction& a, SynthesisPlan& plan) {
   return false;
 }
 
+void plan_bounds(const SynthesisOptions& options, EngineScope scope, SynthesisPlan& plan) {
+  const char* const why = "auto or reference with guarantee: system (its interval bounds are computed on the host's cores)";
+  if (scope == EngineScope::OpenClOnly || options.compute.device == DeviceKind::Cpu ||
+      options.compute.device == DeviceKind::Gpu)
+    throw ConfigError("compute.device", "'" + to_string(options.compute.device) + "' is not supported: expected " +
+                                            why + ", e.g. device: auto");
+  if (!options.compute.devices.empty() || is_scale_out(options))
+    throw ConfigError("compute.devices", std::string("several devices or ranks are not supported: expected ") + why);
+  plan.engine = EngineKind::Bounds;
+  plan.bounds_set = options.compute.device == DeviceKind::Reference ? AmbiguitySet::Joint : AmbiguitySet::Product;
+  note(plan, plan.bounds_set == AmbiguitySet::Joint
+                 ? "guarantee: system, device reference: the joint interval MDP (the oracle; tiny problems)"
+                 : "guarantee: system: the product (orthogonally decoupled) interval MDP on the host's cores");
+}
+
 void plan_team(const Abstraction& a, const SynthesisOptions& options, SynthesisPlan& plan) {
   if (a.unbounded)
     throw ConfigError("spec.horizon", "infinite (interval iteration) runs on one OpenCL device or on compute.device: "
@@ -61,6 +76,7 @@ std::string to_string(EngineKind engine) {
     case EngineKind::Reference: return "reference (serial, double precision)";
     case EngineKind::OneDevice: return "OpenCL, one device";
     case EngineKind::Team: return "OpenCL, several devices or ranks";
+    case EngineKind::Bounds: return "continuous-system bounds (interval MDP on the host's cores)";
   }
   return "?";
 }
@@ -85,6 +101,10 @@ SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& optio
   SynthesisPlan plan;
   plan.multiply_adds_per_step = planned_multiply_adds_per_step(a);
   const bool any = scope == EngineScope::Any;
+  if (a.config.guarantee == Guarantee::System) {
+    plan_bounds(options, scope, plan);
+    return plan;
+  }
   if (any && options.compute.device == DeviceKind::Reference) {
     note(plan, "device: reference (serial, double precision)");
     return plan;

@@ -11,6 +11,7 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
+#include "host/robust_reference.hpp"
 #include "opencl/device.hpp"
 #include "opencl/factored/plan.hpp"
 #include "scale_out/team.hpp"
@@ -20,7 +21,8 @@ namespace amytiss::detail {
 enum class EngineKind {
   Reference,  ///< the serial engine on the host
   OneDevice,  ///< the OpenCL engine on one device
-  Team        ///< the OpenCL engine on several devices or ranks
+  Team,       ///< the OpenCL engine on several devices or ranks
+  Bounds      ///< continuous-system bounds (guarantee: system): the interval MDP on the host's cores
 };
 std::string to_string(EngineKind engine);
 
@@ -38,6 +40,8 @@ struct SynthesisPlan {
   std::optional<FactoredPlan> factored;  ///< OpenCL engines: the factored sweep when chosen, else dense
   double multiply_adds_per_step = 0;     ///< the planned work: the dense sweep's multiply-adds per time step
   bool may_fall_back = false;            ///< a failing device may be retried on the CPU device
+  /// Bounds: the joint interval MDP (device reference: the oracle) or the product set (auto).
+  AmbiguitySet bounds_set = AmbiguitySet::Product;
   std::vector<EngineNote> notes;         ///< the engine, devices and sweep chosen, and why
 };
 
@@ -57,6 +61,8 @@ enum class EngineScope { Any, OpenClOnly };
 /// engine when the planned work is small enough that an OpenCL kernel build would dominate, else
 /// the first GPU, else the CPU device; an explicit kind is honoured or refused. A request that
 /// cannot be honoured is a ConfigError naming its key; DeviceError when no OpenCL device answers.
+/// guarantee: system takes the Bounds engine (auto: product set; reference: joint) and refuses an
+/// OpenCL device or several devices with a ConfigError.
 /// Opens a team's devices (collective over the ranks).
 SynthesisPlan plan_synthesis(const Abstraction& abstraction, const SynthesisOptions& options,
                              EngineScope scope = EngineScope::Any);

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -211,3 +214,31 @@ TEST(Interval, JacobianOfAKnownFunction) {
 
 }  // namespace
 }  // namespace amytiss
+
+TEST(Interval, OutwardRoundingStepsLikeNextafter) {
+  // Every kind of double: zeros of both signs, subnormals, the extremes, infinities, NaN and
+  // random bit patterns (fixed seed).
+  const double infinity = std::numeric_limits<double>::infinity();
+  std::vector<double> samples = {0.0, -0.0, std::numeric_limits<double>::denorm_min(),
+                                 -std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::min(),
+                                 std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(), infinity,
+                                 -infinity, 1.0, -1.0, 0.5, 1e-310, -1e-310};
+  std::mt19937_64 random(20261201);
+  for (int i = 0; i < 100000; ++i) {
+    const std::uint64_t bits = random();
+    double value;
+    std::memcpy(&value, &bits, sizeof value);
+    samples.push_back(value);
+  }
+  for (double value : samples) {
+    const double down = std::nextafter(value, -infinity), up = std::nextafter(value, infinity);
+    if (std::isnan(value)) {
+      EXPECT_TRUE(std::isnan(amytiss::round_down(value)) && std::isnan(amytiss::round_up(value)));
+      continue;
+    }
+    const double rounded_up = amytiss::round_up(value), rounded_down = amytiss::round_down(value);
+    EXPECT_EQ(std::memcmp(&up, &rounded_up, sizeof up), 0) << value;
+    EXPECT_EQ(std::memcmp(&down, &rounded_down, sizeof down), 0) << value;
+    EXPECT_EQ(amytiss::round_up(value, 3), std::nextafter(std::nextafter(up, infinity), infinity)) << value;
+  }
+}

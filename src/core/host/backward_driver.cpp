@@ -7,6 +7,7 @@
 #include "amytiss/resources.hpp"
 #include "host/interval_iteration.hpp"
 #include "host/reference_step.hpp"
+#include "host/robust_iteration.hpp"
 
 namespace amytiss::detail {
 
@@ -92,6 +93,49 @@ Policy run_backward(const Abstraction& a, BellmanStep& step, StepReporter& repor
       reporter.step_done(k, seconds_since(step_start), step.multiply_adds(), step.bytes());
     }
   }
+  reporter.report().host_peak_bytes = peak_resident_bytes();
+  return policy;
+}
+
+Policy run_backward_bounds(const Abstraction& a, IntervalStep& lower, IntervalStep& upper, StepReporter& reporter) {
+  const std::size_t cells = a.states.size();
+  Policy policy;
+  if (a.unbounded) {
+    unsigned last_iteration = 0;
+    const UnboundedRun run{reporter.device(), [&](unsigned iterations, double) {
+                             last_iteration = iterations;
+                             reporter.iteration_done(iterations);
+                           }};
+    policy = solve_unbounded_bounds(a, lower, upper, run, reporter.report());
+    policy.horizon = 1;
+    policy.stationary = true;
+    reporter.unbounded_done(last_iteration);
+  } else {
+    policy.horizon = a.horizon;
+    policy.values.assign((std::size_t(a.horizon) + 1) * cells, 0.0);
+    policy.upper_values.assign(policy.values.size(), 0.0);
+    policy.input_index.assign(std::size_t(a.horizon) * cells, 0);
+    for (std::size_t x = 0; x < cells; ++x) {
+      policy.values[std::size_t(a.horizon) * cells + x] = lower.role_value(lower.roles()[x]);
+      policy.upper_values[std::size_t(a.horizon) * cells + x] = upper.role_value(upper.roles()[x]);
+    }
+    std::vector<std::uint32_t> upper_inputs(cells);
+    reporter.start_steps();
+    for (unsigned k = a.horizon; k-- > 0;) {
+      const auto step_start = SteadyClock::now();
+      lower.apply(&policy.values[std::size_t(k + 1) * cells], &policy.values[std::size_t(k) * cells],
+                  &policy.input_index[std::size_t(k) * cells]);
+      upper.apply(&policy.upper_values[std::size_t(k + 1) * cells], &policy.upper_values[std::size_t(k) * cells],
+                  upper_inputs.data());
+      reporter.step_done(k, seconds_since(step_start), 0, 0);
+    }
+  }
+  policy.states = a.states;
+  policy.inputs = a.inputs;
+  policy.roles = lower.roles();
+  policy.guarantee = Guarantee::System;
+  policy.computed_by = reporter.device();
+  policy.config_hash = config_hash(a.config);
   reporter.report().host_peak_bytes = peak_resident_bytes();
   return policy;
 }

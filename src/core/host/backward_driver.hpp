@@ -10,6 +10,7 @@
 #include "amytiss/stopwatch.hpp"
 #include "amytiss/synthesis_types.hpp"
 #include "host/bellman_step.hpp"
+#include "host/interval_step.hpp"
 
 namespace amytiss::detail {
 
@@ -56,5 +57,14 @@ Policy terminal_policy(const Abstraction& abstraction, const std::string& comput
 /// iteration on it (host/interval_iteration.hpp). Reports every step and the process's peak
 /// resident set; the policy's computed_by is the reporter's device.
 Policy run_backward(const Abstraction& abstraction, BellmanStep& step, StepReporter& reporter);
+
+/// Continuous-system bounds (guarantee: system): applies `lower` and `upper`, the interval MDP's
+/// pessimistic and optimistic steps, together from V_{T_d} (each from its own cell roles) down to
+/// V_0, one step report per time step; or for unbounded specifications runs robust interval
+/// iteration on them (host/robust_iteration.hpp). The policy's values are the lower bounds, its
+/// inputs the lower bound's maximisers, its roles the lower bound's, its upper_values the upper
+/// bounds.
+Policy run_backward_bounds(const Abstraction& abstraction, IntervalStep& lower, IntervalStep& upper,
+                           StepReporter& reporter);
 
 }  // namespace amytiss::detail

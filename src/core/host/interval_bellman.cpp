@@ -1,6 +1,7 @@
 #include "host/interval_bellman.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -26,14 +27,19 @@ double robust_expectation(const double* lo, const double* hi, const double* valu
   }
   const double rounding = robust_expectation_rounding(count);
   require(sum_lo <= 1.0 + rounding && sum_hi >= 1.0 - rounding, "a row with sum lo <= 1 <= sum hi");
-  order.resize(count);
-  std::iota(order.begin(), order.end(), std::size_t(0));
   // The adversary (Lower) fills the lowest values first, the friend (Upper) the highest; stable, so
-  // that ties fill in index order whatever the other values.
-  if (bound == Bound::Lower)
-    std::stable_sort(order.begin(), order.end(), [values](std::size_t i, std::size_t j) { return values[i] < values[j]; });
-  else
-    std::stable_sort(order.begin(), order.end(), [values](std::size_t i, std::size_t j) { return values[i] > values[j]; });
+  // that ties fill in index order whatever the other values. Rows are short (a window and two
+  // outcomes): insertion sort, which allocates nothing.
+  order.resize(count);
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  for (std::size_t j = 0; j < count; ++j) {
+    std::size_t k = j;
+    while (k > 0 && sign * values[order[k - 1]] > sign * values[j]) {
+      order[k] = order[k - 1];
+      --k;
+    }
+    order[k] = j;
+  }
   double budget = 1.0 - sum_lo;
   for (std::size_t j : order) {
     if (!(budget > 0.0)) break;
@@ -45,12 +51,16 @@ double robust_expectation(const double* lo, const double* hi, const double* valu
   return std::clamp(result, 0.0, 1.0);
 }
 
-IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& dimensions) {
+DimensionView view_of(const DimensionBounds& bounds) {
+  return {bounds.first, bounds.cells.size(), bounds.cells.data(), bounds.leave, bounds.cut};
+}
+
+IntervalRow joint_row(const Grid& states, const DimensionView* dimensions) {
   const std::size_t dims = states.dims();
-  require(dims > 0 && dimensions.size() == dims, "one DimensionBounds per state dimension");
+  require(dims > 0, "a state grid with dimensions");
   IntervalRow row;
   bool empty = false;
-  for (const DimensionBounds& dimension : dimensions) empty = empty || dimension.cells.empty();
+  for (std::size_t d = 0; d < dims; ++d) empty = empty || dimensions[d].count == 0;
   std::vector<MassInterval> cells;
   if (!empty) {
     std::vector<std::size_t> multi(dims), offset(dims, 0);  // offset[d]: index into dimensions[d].cells
@@ -66,7 +76,7 @@ IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& di
       row.targets.push_back(states.flat_index(multi.data()));
       std::size_t d = dims;
       while (d-- > 0) {
-        if (++offset[d] < dimensions[d].cells.size()) {
+        if (++offset[d] < dimensions[d].count) {
           ++multi[d];
           break;
         }
@@ -100,6 +110,13 @@ IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& di
   return row;
 }
 
+IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& dimensions) {
+  require(dimensions.size() == states.dims(), "one DimensionBounds per state dimension");
+  std::vector<DimensionView> views;
+  for (const DimensionBounds& dimension : dimensions) views.push_back(view_of(dimension));
+  return joint_row(states, views.data());
+}
+
 double joint_expectation(const IntervalRow& row, const double* values, Bound bound) {
   std::vector<double> outcome_values(row.lo.size());
   for (std::size_t j = 0; j < row.targets.size(); ++j) outcome_values[j] = values[row.targets[j]];
@@ -113,47 +130,65 @@ namespace {
 
 // One stage of the product bound: dimension d's intervals over the values of its window line at
 // flat `offset` (the later dimensions already eliminated below it).
-struct ProductStages {
-  const Grid& states;
-  const std::vector<DimensionBounds>& dimensions;
-  const double* values;
-  Bound bound;
-  std::vector<std::size_t> strides;
-  std::vector<std::size_t> order;
-
-  double eliminate(std::size_t d, std::size_t offset) {
-    const DimensionBounds& dimension = dimensions[d];
-    const std::size_t cells = dimension.cells.size();
-    std::vector<double> lo(cells + 2), hi(cells + 2), line(cells + 2, 0.0);
-    for (std::size_t j = 0; j < cells; ++j) {
-      lo[j] = dimension.cells[j].lo;
-      hi[j] = dimension.cells[j].hi;
-      const std::size_t position = offset + (std::size_t(dimension.first) + j) * strides[d];
-      // An outcome that can get no mass needs no value.
-      if (hi[j] > 0.0) line[j] = d + 1 == dimensions.size() ? values[position] : eliminate(d + 1, position);
-    }
-    lo[cells] = dimension.leave.lo;  // worth 0
-    hi[cells] = dimension.leave.hi;
-    lo[cells + 1] = dimension.cut.lo;
-    hi[cells + 1] = dimension.cut.hi;
-    line[cells + 1] = cut_value(bound);
-    return robust_expectation(lo.data(), hi.data(), line.data(), cells + 2, bound, order);
+double eliminate(const DimensionView* dimensions, std::size_t dims, const double* values, Bound bound,
+                 ProductScratch& scratch, std::size_t d, std::size_t offset) {
+  std::atomic<double>* cached = nullptr;
+  if (scratch.line_cache && d + 1 == dims && dims > 1) {
+    cached = &scratch.line_cache[offset / scratch.strides[d - 1] * scratch.line_cache_stride + scratch.line_bounds];
+    const double known = cached->load(std::memory_order_relaxed);
+    if (!std::isnan(known)) return known;
   }
-};
+  const DimensionView& dimension = dimensions[d];
+  const std::size_t cells = dimension.count;
+  ProductScratch::Stage& stage = scratch.stages[d];
+  stage.lo.resize(cells + 2);
+  stage.hi.resize(cells + 2);
+  stage.line.assign(cells + 2, 0.0);
+  for (std::size_t j = 0; j < cells; ++j) {
+    stage.lo[j] = dimension.cells[j].lo;
+    stage.hi[j] = dimension.cells[j].hi;
+    const std::size_t position = offset + (std::size_t(dimension.first) + j) * scratch.strides[d];
+    // An outcome that can get no mass needs no value.
+    if (stage.hi[j] > 0.0)
+      stage.line[j] = d + 1 == dims ? values[position] : eliminate(dimensions, dims, values, bound, scratch, d + 1, position);
+  }
+  stage.lo[cells] = dimension.leave.lo;  // worth 0
+  stage.hi[cells] = dimension.leave.hi;
+  stage.lo[cells + 1] = dimension.cut.lo;
+  stage.hi[cells + 1] = dimension.cut.hi;
+  stage.line[cells + 1] = cut_value(bound);
+  const double result =
+      robust_expectation(stage.lo.data(), stage.hi.data(), stage.line.data(), cells + 2, bound, scratch.order);
+  // Threads that meet the same line compute the same value: either store is the value.
+  if (cached) cached->store(result, std::memory_order_relaxed);
+  return result;
+}
 
 }  // namespace
 
-double product_expectation(const Grid& states, const std::vector<DimensionBounds>& dimensions, const double* values,
-                           Bound bound) {
+double product_expectation(const Grid& states, const DimensionView* dimensions, const double* values, Bound bound,
+                           ProductScratch& scratch) {
   const std::size_t dims = states.dims();
-  require(dims > 0 && dimensions.size() == dims, "one DimensionBounds per state dimension");
-  ProductStages stages{states, dimensions, values, bound, std::vector<std::size_t>(dims), {}};
+  require(dims > 0, "a state grid with dimensions");
+  if (scratch.strides.size() != dims) {
+    scratch.stages.resize(dims);
+    scratch.strides.resize(dims);
+  }
   std::size_t stride = 1;
   for (std::size_t d = dims; d-- > 0;) {
-    stages.strides[d] = stride;
+    scratch.strides[d] = stride;
     stride *= states.count(d);
   }
-  return stages.eliminate(0, 0);
+  return eliminate(dimensions, dims, values, bound, scratch, 0, 0);
+}
+
+double product_expectation(const Grid& states, const std::vector<DimensionBounds>& dimensions, const double* values,
+                           Bound bound) {
+  require(dimensions.size() == states.dims(), "one DimensionBounds per state dimension");
+  std::vector<DimensionView> views;
+  for (const DimensionBounds& dimension : dimensions) views.push_back(view_of(dimension));
+  ProductScratch scratch;
+  return product_expectation(states, views.data(), values, bound, scratch);
 }
 
 }  // namespace amytiss::detail

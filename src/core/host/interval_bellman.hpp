@@ -12,6 +12,7 @@
 // Mass leaving the grid is worth 0 to both bounds (it fails the specification, as in the
 // abstraction). Cut mass lands on grid cells outside the window, whose values the row does not
 // read: worth 0 to the lower bound and 1 to the upper.
+#include <atomic>
 #include <cstddef>
 #include <vector>
 
@@ -43,8 +44,19 @@ struct IntervalRow {
   std::vector<std::size_t> targets;
   std::vector<double> lo, hi;
 };
+/// One dimension's bounds of a row without owning them: a DimensionBounds or an entry of a packed
+/// store (host/row_bounds.hpp). cells[k] is the mass of grid cell first + k, k < count.
+struct DimensionView {
+  std::int64_t first = 0;
+  std::size_t count = 0;
+  const MassInterval* cells = nullptr;
+  MassInterval leave, cut;
+};
+DimensionView view_of(const DimensionBounds& bounds);
+
 /// Products of the per-dimension bounds (one per state dimension), lo rounded down and hi up at
 /// every multiplication, hi clipped to 1; leave and cut as above, at most remainder() of the cells.
+IntervalRow joint_row(const Grid& states, const DimensionView* dimensions);
 IntervalRow joint_row(const Grid& states, const std::vector<DimensionBounds>& dimensions);
 /// robust_expectation() of a joint row over `values` (one per state cell, flat).
 double joint_expectation(const IntervalRow& row, const double* values, Bound bound);
@@ -55,5 +67,26 @@ double joint_expectation(const IntervalRow& row, const double* values, Bound bou
 /// 0, its cut outcome cut_value(bound).
 double product_expectation(const Grid& states, const std::vector<DimensionBounds>& dimensions, const double* values,
                            Bound bound);
+
+/// Reusable space of product_expectation() (one per thread): after the first rows of a grid it
+/// allocates nothing.
+struct ProductScratch {
+  struct Stage {
+    std::vector<double> lo, hi, line;
+  };
+  std::vector<Stage> stages;           ///< one per dimension
+  std::vector<std::size_t> strides;    ///< flat strides of the state grid
+  std::vector<std::size_t> order;      ///< robust_expectation()'s
+  std::vector<DimensionView> views;    ///< for callers that gather a row's views
+  /// Optional, for rows that share the last dimension's bounds: the last stage's result of the
+  /// line at prefix p (flat index over the other dimensions) is kept at
+  /// line_cache[p * line_cache_stride + line_bounds]; NaN: not computed yet. The cache belongs to
+  /// one `values` vector and one bound.
+  std::atomic<double>* line_cache = nullptr;
+  std::size_t line_cache_stride = 0, line_bounds = 0;
+};
+/// product_expectation() of one row given as one view per state dimension.
+double product_expectation(const Grid& states, const DimensionView* dimensions, const double* values, Bound bound,
+                           ProductScratch& scratch);
 
 }  // namespace amytiss::detail

@@ -1,0 +1,53 @@
+#pragma once
+// The robust Bellman step of the interval MDP (docs/semantics.md, "Interval transition bounds"):
+//   out(x) = max_u min_w  min (Lower) / max (Upper) over the row's ambiguity set of E[in(x')]
+// on Free cells, fixed cells holding their role's value; the step every engine of continuous-
+// system bounds runs through the backward driver, on the host's cores.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "host/bellman_step.hpp"
+#include "host/interval_bellman.hpp"
+#include "host/robust_reference.hpp"
+#include "host/row_bounds.hpp"
+
+namespace amytiss::detail {
+
+class IntervalStep : public BellmanStep {
+ public:
+  /// At most this many entries (8 bytes each) in the cache of the product set's last stage.
+  static constexpr std::size_t kMaxLineCacheEntries = std::size_t(1) << 24;
+  /// `roles`: the bound's cell roles (robust_cell_roles()); `rows` must hold every Free cell's rows.
+  IntervalStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles, Bound bound,
+               AmbiguitySet set, unsigned threads);
+  void apply(const double* in, double* out, std::uint32_t* chosen) override;
+  /// The step of one stationary controller (certification): out(x) = min_w of the bound's
+  /// expectation with input controller[x]; fixed cells hold their role's value.
+  void evaluate(const double* in, double* out, const std::uint32_t* controller);
+  /// The O-maximisation's outward rounding keeps the sequences apart by at most this.
+  double resolution() const override { return 1e-12; }
+  const std::vector<CellRole>& roles() const { return roles_; }
+  /// The value of a fixed cell, and a Free cell's terminal value V_{T_d}.
+  double role_value(CellRole role) const;
+
+ private:
+  double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;
+  double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
+  void reset_line_cache();
+  void use_line_cache(ProductScratch& scratch) const;
+  const Abstraction& a_;
+  const RowBounds& rows_;
+  std::vector<CellRole> roles_;
+  Bound bound_;
+  AmbiguitySet set_;
+  unsigned threads_;
+  // The product set's last stage per (line, last dimension's bounds), shared by the rows of one
+  // step (ProductScratch::line_cache); empty when it would not pay.
+  std::unique_ptr<std::atomic<double>[]> line_cache_;
+  std::size_t line_cache_entries_ = 0;
+};
+
+}  // namespace amytiss::detail

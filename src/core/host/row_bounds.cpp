@@ -1,0 +1,137 @@
+#include "host/row_bounds.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <unordered_map>
+
+namespace amytiss::detail {
+
+void parallel_for(std::size_t count, unsigned threads,
+                  const std::function<void(unsigned part, std::size_t first, std::size_t last)>& body) {
+  threads = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, count)));
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto part = [&](unsigned t) {
+    try {
+      body(t, count * t / threads, count * (t + 1) / threads);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+    }
+  };
+  std::vector<std::thread> workers;
+  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(part, t);
+  part(0);
+  for (std::thread& worker : workers) worker.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+unsigned host_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+namespace {
+
+// The arguments that determine one dimension's bounds, compared bit for bit.
+struct BoundsKey {
+  double m_lo, m_hi, s_lo, s_hi;
+  bool operator==(const BoundsKey& other) const {
+    return std::memcmp(this, &other, sizeof(BoundsKey)) == 0;
+  }
+};
+struct BoundsKeyHash {
+  std::size_t operator()(const BoundsKey& key) const {
+    std::uint64_t words[4];
+    std::memcpy(words, &key, sizeof words);
+    std::uint64_t hash = 0x9e3779b97f4a7c15ull;
+    for (std::uint64_t word : words) hash = (hash ^ word) * 0x100000001b3ull + (hash >> 29);
+    return std::size_t(hash);
+  }
+};
+
+// One worker's distinct bounds: per dimension the views (cells as offsets into the pool until
+// the pool stops growing) and the index of each key.
+struct WorkerTables {
+  std::vector<MassInterval> pool;
+  std::vector<std::vector<DimensionView>> distinct;
+  std::vector<std::vector<std::size_t>> pool_offset;
+  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash>> index;
+};
+
+}  // namespace
+
+RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturbances, const NoiseModel& noise,
+                     const MeanBox& mean_box, const std::vector<bool>& needed, unsigned threads)
+    : dims_(states.dims()), inputs_(inputs.size()), disturbances_(disturbances.size()) {
+  const std::size_t cells = states.size();
+  index_.assign(cells * inputs_ * disturbances_ * dims_, 0);
+  threads = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, cells)));
+  std::vector<MassBounds> per_dimension;
+  for (std::size_t d = 0; d < dims_; ++d) per_dimension.emplace_back(noise, d);
+  std::vector<WorkerTables> tables(threads);
+  parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
+    WorkerTables& table = tables[worker];
+    table.distinct.resize(dims_);
+    table.pool_offset.resize(dims_);
+    table.index.resize(dims_);
+    std::vector<double> lo(dims_), hi(dims_);
+    std::vector<std::size_t> multi(dims_);
+    for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
+      if (!needed[cell]) continue;
+      states.multi_index(cell, multi.data());
+      for (std::size_t r = row(cell, 0, 0); r < row(cell + 1, 0, 0); ++r) {
+        mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
+        for (std::size_t d = 0; d < dims_; ++d) {
+          const double face_lo = states.lb()[d] + (double(multi[d]) - 0.5) * states.eta()[d];
+          const double face_hi = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
+          const MassInterval scale = per_dimension[d].scale_range(face_lo, face_hi);
+          const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
+          const auto found = table.index[d].emplace(key, std::uint32_t(table.distinct[d].size()));
+          index_[r * dims_ + d] = found.first->second;
+          if (!found.second) continue;
+          const DimensionBounds bounds = per_dimension[d].dimension_bounds(states, lo[d], hi[d], scale.lo, scale.hi);
+          table.distinct[d].push_back({bounds.first, bounds.cells.size(), nullptr, bounds.leave, bounds.cut});
+          table.pool_offset[d].push_back(table.pool.size());
+          table.pool.insert(table.pool.end(), bounds.cells.begin(), bounds.cells.end());
+        }
+      }
+    }
+  });
+  // One entry per distinct key over all workers: a later worker's entry that an earlier one has
+  // becomes that one's index.
+  distinct_.resize(dims_);
+  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash>> merged(dims_);
+  std::vector<std::vector<std::vector<std::uint32_t>>> global(threads, std::vector<std::vector<std::uint32_t>>(dims_));
+  for (unsigned worker = 0; worker < threads; ++worker) {
+    WorkerTables& table = tables[worker];
+    for (std::size_t d = 0; d < dims_ && !table.distinct.empty(); ++d) {
+      global[worker][d].resize(table.distinct[d].size());
+      for (const auto& [key, local] : table.index[d]) {
+        const auto found = merged[d].emplace(key, std::uint32_t(distinct_[d].size()));
+        global[worker][d][local] = found.first->second;
+        if (!found.second) continue;
+        DimensionView view = table.distinct[d][local];
+        view.cells = table.pool.data() + table.pool_offset[d][local];
+        distinct_[d].push_back(view);
+      }
+    }
+    pool_size_ += table.pool.size();
+    pools_.push_back(std::move(table.pool));  // moving keeps the data where the views point
+  }
+  parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
+    for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
+      if (!needed[cell]) continue;
+      for (std::size_t r = row(cell, 0, 0); r < row(cell + 1, 0, 0); ++r)
+        for (std::size_t d = 0; d < dims_; ++d) index_[r * dims_ + d] = global[worker][d][index_[r * dims_ + d]];
+    }
+  });
+}
+
+std::size_t RowBounds::bytes() const {
+  std::size_t views = 0;
+  for (const auto& table : distinct_) views += table.size();
+  return index_.size() * sizeof(std::uint32_t) + views * sizeof(DimensionView) + pool_size_ * sizeof(MassInterval);
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,58 @@
+#pragma once
+// The per-dimension transition bounds of every row (state cell, input, disturbance) of the
+// interval MDP of a configuration (docs/semantics.md, "Interval transition bounds"), computed once
+// on the host's cores. A dimension's bounds depend only on its mean interval and scale range:
+// rows that share them (post coordinates that read few variables) share one entry, computed once.
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "host/interval_bellman.hpp"
+#include "host/robust_reference.hpp"
+
+namespace amytiss::detail {
+
+class RowBounds {
+ public:
+  /// Bounds of the rows of every cell with needed[cell] true, from mean boxes (state units) of
+  /// f(x, u, w) over the cell and the noise's MassBounds per dimension; `threads` workers (>= 1).
+  RowBounds(const Grid& states, const Grid& inputs, const Grid& disturbances, const NoiseModel& noise,
+            const MeanBox& mean_box, const std::vector<bool>& needed, unsigned threads);
+
+  /// Row of (cell, input, disturbance); the cell must be one the store was built for.
+  std::size_t row(std::size_t cell, std::size_t input, std::size_t disturbance) const {
+    return (cell * inputs_ + input) * disturbances_ + disturbance;
+  }
+  /// Index of the row's bounds of dimension d among distinct_bounds(d) entries.
+  std::uint32_t bounds_index(std::size_t row, std::size_t d) const { return index_[row * dims_ + d]; }
+  /// The row's bounds, one view per state dimension, written to out[0..dims) (valid while the
+  /// store lives).
+  void dimensions(std::size_t row, DimensionView* out) const {
+    for (std::size_t d = 0; d < dims_; ++d) out[d] = distinct_[d][index_[row * dims_ + d]];
+  }
+  /// Distinct bounds of dimension d.
+  std::size_t distinct_bounds(std::size_t d) const { return distinct_[d].size(); }
+  /// Mass intervals stored, and bytes in all.
+  std::size_t intervals() const { return pool_size_; }
+  std::size_t bytes() const;
+
+ private:
+  std::size_t dims_, inputs_, disturbances_;
+  std::vector<std::uint32_t> index_;                 // [row * dims + d]; rows of unneeded cells: 0
+  std::vector<std::vector<DimensionView>> distinct_;  // per dimension
+  std::vector<std::vector<MassInterval>> pools_;      // one per worker; views point into them
+  std::size_t pool_size_ = 0;
+};
+
+/// Runs body(part, first, last) over [0, count) split into min(threads, count) contiguous parts
+/// (part 0, 1, ...) on as many threads (the calling thread takes part 0); rethrows the first
+/// exception of a part.
+void parallel_for(std::size_t count, unsigned threads,
+                  const std::function<void(unsigned part, std::size_t first, std::size_t last)>& body);
+
+/// Worker threads for the host's interval MDP work: the hardware's concurrency (at least 1).
+unsigned host_threads();
+
+}  // namespace amytiss::detail

@@ -1,0 +1,43 @@
+#include "host/system_engine.hpp"
+
+#include "amytiss/enclosure.hpp"
+#include "amytiss/format.hpp"
+#include "host/enclosure_mean_box.hpp"
+#include "host/interval_step.hpp"
+#include "host/row_bounds.hpp"
+
+namespace amytiss::detail {
+
+Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& reporter) {
+  const unsigned threads = set == AmbiguitySet::Joint ? 1u : host_threads();
+  reporter.set_device(set == AmbiguitySet::Joint ? "reference"
+                                                 : "host (" + std::to_string(threads) + " thread" +
+                                                       (threads == 1 ? "" : "s") + ")");
+  reporter.reached(Phase::Setup);
+  const auto construction_start = SteadyClock::now();
+  std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
+  std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
+  std::vector<bool> needed(a.states.size());
+  for (std::size_t x = 0; x < needed.size(); ++x)
+    needed[x] = lower_roles[x] == CellRole::Free || upper_roles[x] == CellRole::Free;
+  const ImageEnclosure enclosure(a.config);
+  const RowBounds rows(a.states, a.inputs, a.disturbances, *a.noise,
+                       enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, threads);
+  const double construction_seconds = seconds_since(construction_start);
+  reporter.phase(PhaseKind::Construction, "interval bounds", construction_seconds,
+                 double(a.pairs()) / std::max(construction_seconds, 1e-9));
+  reporter.report().transitions = "interval bounds per dimension: " + format_bytes(double(rows.bytes())) +
+                                  " on the host (" + std::to_string(rows.intervals()) + " mass intervals)";
+  reporter.report().notes.push_back(
+      {NoteSeverity::Info, NoteKind::Transitions,
+       "continuous-system bounds: image enclosures of every cell, " + std::to_string(rows.intervals()) +
+           " per-dimension mass intervals (" + format_bytes(double(rows.bytes())) + "), " +
+           (set == AmbiguitySet::Joint ? "joint interval MDP" : "product interval MDP") + " on " +
+           std::to_string(threads) + " host thread" + (threads == 1 ? "" : "s")});
+  reporter.reached(Phase::Construction);
+  IntervalStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads);
+  IntervalStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads);
+  return run_backward_bounds(a, lower, upper, reporter);
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,153 @@
+// The engine of continuous-system bounds (guarantee: system): synthesize() gives the oracle's
+// bounds (host/robust_reference.hpp; product set with device auto, joint interval MDP with device
+// reference) on bounded horizons, keeps lower <= upper, stores both in the policy file, answers
+// unbounded specifications with sound bounds, and the plan and validation refuse what it cannot run.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "amytiss/enclosure.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
+#include "amytiss/policy_file.hpp"
+#include "host/enclosure_mean_box.hpp"
+#include "host/robust_reference.hpp"
+#include "test_support.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+using namespace amytiss::test_support;
+
+// The engine and the oracle do the same arithmetic in the same order; they agree to this (and in
+// practice bit for bit).
+constexpr double kAgreement = 1e-9;
+constexpr double kOrderSlack = 1e-12;
+
+std::string with_system(std::string yaml) { return yaml + "guarantee: system\n"; }
+
+// A nonlinear 3-d system with a disturbance: the product set's line cache, the joint rows and the
+// adversary all take part.
+std::string small_3d_yaml(unsigned horizon, bool truncated = true) {
+  return "name: system_3d\n"
+         "states: {lb: [-2, -2, -1], ub: [2, 2, 1], eta: [0.5, 0.5, 0.5]}\n"
+         "inputs: {lb: [-0.5], ub: [0.5], eta: [0.5]}\n"
+         "disturbances: {lb: [-0.1], ub: [0.1], eta: [0.2]}\n"
+         "dynamics: [\"x0 + 0.5*x1\", \"0.9*x1 + 0.2*sin(x0) + u0 + w0\", \"0.8*x2 + 0.1*x0*x1\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.04, 0.04, 0.02]" +
+         std::string(truncated ? ",\n        truncation: cutting_probability, cutting_probability: 1.0e-4}\n" : "}\n") +
+         "spec: {type: reach_avoid, horizon: " + std::to_string(horizon) +
+         ", target: {lb: [1, -2, -1], ub: [2, 2, 1]}, avoid: {lb: [-2, -2, -1], ub: [-1.5, 2, 1]}}\n";
+}
+
+RobustValues oracle(const Abstraction& a, AmbiguitySet set) {
+  const ImageEnclosure enclosure(a.config);
+  RobustProblem problem{a.states, a.inputs, a.disturbances, *a.noise,
+                        enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances)};
+  problem.spec = a.spec;
+  problem.horizon = a.horizon;
+  problem.lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
+  problem.upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
+  return robust_values(problem, set);
+}
+
+SynthesisOptions options_for(DeviceKind device) {
+  SynthesisOptions options;
+  options.compute.device = device;
+  return options;
+}
+
+void expect_matches_oracle(const std::string& yaml, DeviceKind device, AmbiguitySet set) {
+  const Abstraction a = from_yaml(with_system(yaml));
+  const Policy policy = synthesize(a, options_for(device), nullptr);
+  const RobustValues expected = oracle(a, set);
+  ASSERT_EQ(policy.guarantee, Guarantee::System);
+  ASSERT_EQ(policy.upper_values.size(), policy.values.size());
+  const std::size_t cells = a.states.size();
+  for (std::size_t x = 0; x < cells; ++x) {
+    EXPECT_NEAR(policy.value(0, x), expected.lower[x], kAgreement) << "cell " << x;
+    EXPECT_NEAR(policy.upper_value(0, x), expected.upper[x], kAgreement) << "cell " << x;
+    for (unsigned k = 0; k < a.horizon; ++k) {
+      EXPECT_EQ(policy.input(k, x), expected.controller[std::size_t(k) * cells + x]) << "cell " << x << " step " << k;
+      EXPECT_LE(policy.value(k, x), policy.upper_value(k, x) + kOrderSlack) << "cell " << x << " step " << k;
+    }
+  }
+}
+
+TEST(SystemEngine, ProductEngineGivesTheOraclesBoundsAndController) {
+  expect_matches_oracle(robot_disturbance_yaml(), DeviceKind::Auto, AmbiguitySet::Product);
+  expect_matches_oracle(small_3d_yaml(3), DeviceKind::Auto, AmbiguitySet::Product);
+}
+
+TEST(SystemEngine, ReferenceDeviceGivesTheJointOraclesBounds) {
+  expect_matches_oracle(small_3d_yaml(2), DeviceKind::Reference, AmbiguitySet::Joint);
+}
+
+TEST(SystemEngine, TheAbstractionLiesBetweenTheBoundsWhereSetsAlignWithCells) {
+  // The target and avoid boxes of small_3d_yaml lie on cell faces. Without truncation: the
+  // abstraction drops cut mass that the interval MDP keeps.
+  const std::string yaml = small_3d_yaml(3, false);
+  const Policy abstraction = synthesize(from_yaml(yaml), options_for(DeviceKind::Reference), nullptr);
+  const Policy bounds = synthesize(from_yaml(with_system(yaml)), options_for(DeviceKind::Auto), nullptr);
+  for (std::size_t x = 0; x < abstraction.states.size(); ++x) {
+    EXPECT_LE(bounds.value(0, x), abstraction.value(0, x) + kOrderSlack) << "cell " << x;
+    EXPECT_LE(abstraction.value(0, x), bounds.upper_value(0, x) + kOrderSlack) << "cell " << x;
+  }
+}
+
+TEST(SystemEngine, PolicyFileKeepsBothBoundsAndTheDefaultKeepsTheHash) {
+  const std::filesystem::path directory = fresh_test_directory("amytiss_system_engine_");
+  const Abstraction a = from_yaml(with_system(robot_disturbance_yaml()));
+  const Policy policy = synthesize(a, options_for(DeviceKind::Auto), nullptr);
+  write_policy_file((directory / "bounds.h5").string(), policy, a.config);
+  const LoadedPolicy loaded = read_policy_file((directory / "bounds.h5").string());
+  EXPECT_EQ(loaded.policy.guarantee, Guarantee::System);
+  EXPECT_EQ(loaded.policy.upper_values, policy.upper_values);
+  EXPECT_EQ(loaded.policy.values, policy.values);
+  // The default guarantee leaves the configuration's text, and so its hash, as it was.
+  const Config plain = config_from_yaml(YAML::Load(robot_disturbance_yaml()));
+  const Config explicit_default = config_from_yaml(YAML::Load(robot_disturbance_yaml() + "guarantee: abstraction\n"));
+  EXPECT_EQ(config_hash(plain), config_hash(explicit_default));
+  EXPECT_NE(config_hash(plain), config_hash(a.config));
+  std::filesystem::remove_all(directory);
+}
+
+TEST(SystemEngine, UnboundedReachAvoidHasSoundBoundsAroundTheBoundedOnes) {
+  // Reaching within 3 steps is no more likely than ever reaching: the unbounded upper bound lies
+  // above the 3-step lower bound, and the certified stationary lower bound below the upper one.
+  std::string unbounded = small_3d_yaml(3);
+  unbounded.replace(unbounded.find("horizon: 3"), 10, "horizon: infinite, tolerance: 1.0e-4");
+  const Policy stationary = synthesize(from_yaml(with_system(unbounded)), options_for(DeviceKind::Auto), nullptr);
+  const Policy bounded = synthesize(from_yaml(with_system(small_3d_yaml(3))), options_for(DeviceKind::Auto), nullptr);
+  ASSERT_TRUE(stationary.stationary);
+  EXPECT_EQ(stationary.guarantee, Guarantee::System);
+  ASSERT_EQ(stationary.upper_values.size(), stationary.states.size());
+  EXPECT_GT(stationary.iterations, 0u);
+  for (std::size_t x = 0; x < stationary.states.size(); ++x) {
+    EXPECT_LE(stationary.value(0, x), stationary.upper_value(0, x) + kOrderSlack) << "cell " << x;
+    EXPECT_LE(bounded.value(0, x), stationary.upper_value(0, x) + kOrderSlack) << "cell " << x;
+  }
+  EXPECT_EQ(stationary.converged, stationary.gap <= 1.0e-4);
+}
+
+TEST(SystemEngine, OpenClDevicesAndFullCovariancesAreRefusedNamingTheKey) {
+  const Abstraction a = from_yaml(with_system(robot_disturbance_yaml()));
+  try {
+    synthesize(a, options_for(DeviceKind::Cpu), nullptr);
+    FAIL() << "an OpenCL device was accepted for guarantee: system";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("compute.device"), std::string::npos) << error.what();
+  }
+  std::string full = with_system(robot_disturbance_yaml());
+  full.replace(full.find("covariance: [0.75, 0.75]"), 24, "covariance: [0.75, 0.1, 0.1, 0.75]");
+  try {
+    from_yaml(full);
+    FAIL() << "a full covariance was accepted for guarantee: system";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("noise.covariance"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace amytiss::detail
