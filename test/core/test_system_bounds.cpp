@@ -15,6 +15,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <random>
@@ -405,10 +407,10 @@ TEST(SystemBounds, MonteCarloOfANonlinearSystemLiesBetweenTheBounds) {
       }
     }
     // A wrong controller falls below the lower bound: the check can fail.
-    std::printf("[ figures  ] %s: cells %zu %zu %zu %zu (lower %.3f..%.3f): min (rate - lower)/SE %.1f, min (upper - "
-                "rate)/SE %.1f; mirrored controller below lower - 4 SE by up to %.3f\n",
-                set == AmbiguitySet::Joint ? "joint" : "product", starts[0], starts[1], starts[2], starts[3],
-                bounds.lower[starts[3]], bounds.lower[starts[0]], closest_lower, closest_upper, mirrored_shortfall);
+    std::printf("[ figures  ] %s: %zu start cells: min (rate - lower)/SE %.1f, min (upper - rate)/SE %.1f; "
+                "mirrored controller below lower - 4 SE by up to %.3f\n",
+                set == AmbiguitySet::Joint ? "joint" : "product", kStartCells, closest_lower, closest_upper,
+                mirrored_shortfall);
     EXPECT_GT(mirrored_shortfall, 0.0);
   }
 }
