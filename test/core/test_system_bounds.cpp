@@ -409,7 +409,8 @@ TEST(SystemBounds, MonteCarloOfANonlinearSystemLiesBetweenTheBounds) {
       }
     }
     // A wrong controller falls below the lower bound: the check can fail.
-    std::printf("[ figures  ] %s: %zu start cells: min (rate - lower)/SE %.1f, min (upper - rate)/SE %.1f; "
+    std::printf("[ figures  ] %s: %zu start cells: min (rate - lower)/SE %.1f, min (upper - rate)/SE "
+                "%.1f; "
                 "mirrored controller below lower - 4 SE by up to %.3f\n",
                 set == AmbiguitySet::Joint ? "joint" : "product", kStartCells, closest_lower, closest_upper,
                 mirrored_shortfall);
@@ -507,7 +508,8 @@ void expect_point_boxes_reproduce_the_abstraction(const std::string& yaml) {
     const RobustValues bounds = system_bounds(a, set, point);
     double largest = 0;
     for (std::size_t c = 0; c < abstraction.size(); ++c)
-      largest = std::max({largest, std::abs(bounds.lower[c] - abstraction[c]), std::abs(bounds.upper[c] - abstraction[c])});
+      largest = std::max(
+          {largest, std::abs(bounds.lower[c] - abstraction[c]), std::abs(bounds.upper[c] - abstraction[c])});
     std::printf("[ figures  ] %s %s, point mean boxes: max |bound - V_abs| %.3e\n", a.config.name.c_str(),
                 set == AmbiguitySet::Joint ? "joint" : "product", largest);
     EXPECT_LE(largest, kOutwardRounding);
