@@ -335,8 +335,8 @@ std::string heading_2d_yaml(double disturbance = 0, unsigned horizon = 6) {
 // The fraction of kRunsPerStart runs of the continuous system from `start` under `controller`
 // (played by the cell that holds the state) that satisfy the specification: the sets checked at
 // every step 0..T, a state off the covered set fails.
-double success_rate(const Abstraction& a, const std::vector<std::uint32_t>& controller, const std::vector<double>& start,
-                    std::mt19937_64& random) {
+double success_rate(const Abstraction& a, const std::vector<std::uint32_t>& controller,
+                    const std::vector<double>& start, std::mt19937_64& random) {
   std::normal_distribution<double> normal(0.0, 1.0);
   const std::size_t cells = a.states.size();
   int successes = 0;
