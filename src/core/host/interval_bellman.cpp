@@ -133,8 +133,9 @@ namespace {
 double eliminate(const DimensionView* dimensions, std::size_t dims, const double* values, Bound bound,
                  ProductScratch& scratch, std::size_t d, std::size_t offset) {
   std::atomic<double>* cached = nullptr;
-  if (scratch.line_cache && d + 1 == dims && dims > 1) {
-    cached = &scratch.line_cache[offset / scratch.strides[d - 1] * scratch.line_cache_stride + scratch.line_bounds];
+  if (d > 0 && !scratch.caches.empty() && scratch.caches[d].table) {
+    const ProductScratch::StageCache& cache = scratch.caches[d];
+    cached = &cache.table[offset / scratch.strides[d - 1] * cache.classes + cache.row_class];
     const double known = cached->load(std::memory_order_relaxed);
     if (!std::isnan(known)) return known;
   }
@@ -159,7 +160,7 @@ double eliminate(const DimensionView* dimensions, std::size_t dims, const double
   stage.line[cells + 1] = cut_value(bound);
   const double result =
       robust_expectation(stage.lo.data(), stage.hi.data(), stage.line.data(), cells + 2, bound, scratch.order);
-  // Threads that meet the same line compute the same value: either store is the value.
+  // Threads that meet the same line and class compute the same value: either store is it.
   if (cached) cached->store(result, std::memory_order_relaxed);
   return result;
 }

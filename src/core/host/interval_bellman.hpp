@@ -78,12 +78,16 @@ struct ProductScratch {
   std::vector<std::size_t> strides;    ///< flat strides of the state grid
   std::vector<std::size_t> order;      ///< robust_expectation()'s
   std::vector<DimensionView> views;    ///< for callers that gather a row's views
-  /// Optional, for rows that share the last dimension's bounds: the last stage's result of the
-  /// line at prefix p (flat index over the other dimensions) is kept at
-  /// line_cache[p * line_cache_stride + line_bounds]; NaN: not computed yet. The cache belongs to
-  /// one `values` vector and one bound.
-  std::atomic<double>* line_cache = nullptr;
-  std::size_t line_cache_stride = 0, line_bounds = 0;
+  /// Optional, for rows that share the bounds of dimensions d..dims-1 (1 <= d < dims): stage d's
+  /// result on the window line at prefix p (flat index over dimensions 0..d-1) is kept at
+  /// table[p * classes + row_class]; NaN: not computed yet. A cache belongs to one `values`
+  /// vector and one bound; the caller sets row_class for each row.
+  struct StageCache {
+    std::atomic<double>* table = nullptr;  ///< null: stage d is not cached
+    std::size_t classes = 0;
+    std::size_t row_class = 0;
+  };
+  std::vector<StageCache> caches;  ///< per dimension, or empty
 };
 /// product_expectation() of one row given as one view per state dimension.
 double product_expectation(const Grid& states, const DimensionView* dimensions, const double* values, Bound bound,

@@ -8,27 +8,35 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
                            Bound bound, AmbiguitySet set, unsigned threads)
     : a_(abstraction), rows_(rows), roles_(std::move(roles)), bound_(bound), set_(set), threads_(threads) {
   const std::size_t dims = a_.states.dims();
-  if (set_ != AmbiguitySet::Product || dims < 2) return;
-  const std::size_t prefixes = a_.states.size() / a_.states.count(dims - 1);
-  const std::size_t entries = prefixes * rows_.distinct_bounds(dims - 1);
-  // Clearing it at every step costs little beside the lines the rows compute (a window's width
-  // per row and more); a cache far larger than that would not pay.
+  stage_caches_.resize(dims);
+  stage_cache_entries_.assign(dims, 0);
+  if (set_ != AmbiguitySet::Product) return;
+  // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
+  // when it has fewer entries than the lines the rows would compute (kLinesPerRow per row and
+  // stage at least) and fits the budget; clearing it at every step is then cheap.
   constexpr std::size_t kLinesPerRow = 16;
-  if (entries == 0 || entries > kMaxLineCacheEntries || entries > kLinesPerRow * a_.triples()) return;
-  line_cache_.reset(new std::atomic<double>[entries]);
-  line_cache_entries_ = entries;
+  std::size_t budget = kMaxStageCacheEntries, prefixes = a_.states.size();
+  for (std::size_t d = dims; d-- > 1;) {
+    prefixes /= a_.states.count(d);
+    const std::size_t entries = prefixes * rows_.suffix_classes(d);
+    if (entries == 0 || entries > budget || entries > kLinesPerRow * a_.triples()) continue;
+    stage_caches_[d].reset(new std::atomic<double>[entries]);
+    stage_cache_entries_[d] = entries;
+    budget -= entries;
+  }
 }
 
-void IntervalStep::reset_line_cache() {
-  for (std::size_t i = 0; i < line_cache_entries_; ++i)
-    line_cache_[i].store(std::numeric_limits<double>::quiet_NaN(), std::memory_order_relaxed);
+void IntervalStep::reset_stage_caches() {
+  for (std::size_t d = 0; d < stage_caches_.size(); ++d)
+    for (std::size_t i = 0; i < stage_cache_entries_[d]; ++i)
+      stage_caches_[d][i].store(std::numeric_limits<double>::quiet_NaN(), std::memory_order_relaxed);
 }
 
-void IntervalStep::use_line_cache(ProductScratch& scratch) const {
+void IntervalStep::use_stage_caches(ProductScratch& scratch) const {
   scratch.views.resize(a_.states.dims());
-  if (!line_cache_entries_) return;
-  scratch.line_cache = line_cache_.get();
-  scratch.line_cache_stride = rows_.distinct_bounds(a_.states.dims() - 1);
+  scratch.caches.assign(a_.states.dims(), {});
+  for (std::size_t d = 1; d < stage_caches_.size(); ++d)
+    if (stage_cache_entries_[d]) scratch.caches[d] = {stage_caches_[d].get(), rows_.suffix_classes(d), 0};
 }
 
 double IntervalStep::role_value(CellRole role) const {
@@ -40,7 +48,8 @@ double IntervalStep::role_value(CellRole role) const {
 double IntervalStep::expectation(std::size_t row, const double* in, ProductScratch& scratch) const {
   DimensionView* views = scratch.views.data();
   rows_.dimensions(row, views);
-  if (scratch.line_cache) scratch.line_bounds = rows_.bounds_index(row, a_.states.dims() - 1);
+  for (std::size_t d = 1; d < scratch.caches.size(); ++d)
+    if (scratch.caches[d].table) scratch.caches[d].row_class = rows_.suffix_class(row, d);
   if (set_ == AmbiguitySet::Product) return product_expectation(a_.states, views, in, bound_, scratch);
   return joint_expectation(joint_row(a_.states, views), in, bound_);
 }
@@ -53,10 +62,10 @@ double IntervalStep::worst_case(std::size_t cell, std::size_t input, const doubl
 }
 
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
-  reset_line_cache();
+  reset_stage_caches();
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
-    use_line_cache(scratch);
+    use_stage_caches(scratch);
     for (std::size_t cell = first; cell < last; ++cell) {
       chosen[cell] = 0;
       if (roles_[cell] != CellRole::Free) {
@@ -77,10 +86,10 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
 }
 
 void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* controller) {
-  reset_line_cache();
+  reset_stage_caches();
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
-    use_line_cache(scratch);
+    use_stage_caches(scratch);
     for (std::size_t cell = first; cell < last; ++cell)
       out[cell] = roles_[cell] == CellRole::Free ? worst_case(cell, controller[cell], in, scratch)
                                                  : role_value(roles_[cell]);

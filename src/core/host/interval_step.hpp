@@ -18,8 +18,8 @@ namespace amytiss::detail {
 
 class IntervalStep : public BellmanStep {
  public:
-  /// At most this many entries (8 bytes each) in the cache of the product set's last stage.
-  static constexpr std::size_t kMaxLineCacheEntries = std::size_t(1) << 24;
+  /// At most this many entries (8 bytes each) in the caches of the product set's stages.
+  static constexpr std::size_t kMaxStageCacheEntries = std::size_t(1) << 24;
   /// `roles`: the bound's cell roles (robust_cell_roles()); `rows` must hold every Free cell's rows.
   IntervalStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles, Bound bound,
                AmbiguitySet set, unsigned threads);
@@ -36,18 +36,18 @@ class IntervalStep : public BellmanStep {
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
-  void reset_line_cache();
-  void use_line_cache(ProductScratch& scratch) const;
+  void reset_stage_caches();
+  void use_stage_caches(ProductScratch& scratch) const;
   const Abstraction& a_;
   const RowBounds& rows_;
   std::vector<CellRole> roles_;
   Bound bound_;
   AmbiguitySet set_;
   unsigned threads_;
-  // The product set's last stage per (line, last dimension's bounds), shared by the rows of one
-  // step (ProductScratch::line_cache); empty when it would not pay.
-  std::unique_ptr<std::atomic<double>[]> line_cache_;
-  std::size_t line_cache_entries_ = 0;
+  // The product set's stages per (window line, suffix class), shared by the rows of one step
+  // (ProductScratch::caches); per dimension, empty where it would not pay.
+  std::vector<std::unique_ptr<std::atomic<double>[]>> stage_caches_;
+  std::vector<std::size_t> stage_cache_entries_;
 };
 
 }  // namespace amytiss::detail

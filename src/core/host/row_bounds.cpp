@@ -126,12 +126,33 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
         for (std::size_t d = 0; d < dims_; ++d) index_[r * dims_ + d] = global[worker][d][index_[r * dims_ + d]];
     }
   });
+  number_suffix_classes(needed);
+}
+
+void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {
+  // class_d(row) numbers the pairs (bounds of d, class_{d+1}(row)), the last dimension's class
+  // being its bounds' index.
+  suffix_class_.assign(index_.size(), 0);
+  suffix_classes_.assign(dims_, 0);
+  const std::size_t rows_per_cell = inputs_ * disturbances_;
+  for (std::size_t d = dims_; d-- > 1;) {
+    std::unordered_map<std::uint64_t, std::uint32_t> classes;
+    for (std::size_t cell = 0; cell < needed.size(); ++cell) {
+      if (!needed[cell]) continue;
+      for (std::size_t r = cell * rows_per_cell; r < (cell + 1) * rows_per_cell; ++r) {
+        const std::uint64_t next = d + 1 < dims_ ? suffix_class_[r * dims_ + d + 1] : 0;
+        const std::uint64_t pair = (next << 32) | index_[r * dims_ + d];
+        suffix_class_[r * dims_ + d] = classes.emplace(pair, std::uint32_t(classes.size())).first->second;
+      }
+    }
+    suffix_classes_[d] = classes.size();
+  }
 }
 
 std::size_t RowBounds::bytes() const {
   std::size_t views = 0;
   for (const auto& table : distinct_) views += table.size();
-  return index_.size() * sizeof(std::uint32_t) + views * sizeof(DimensionView) + pool_size_ * sizeof(MassInterval);
+  return 2 * index_.size() * sizeof(std::uint32_t) + views * sizeof(DimensionView) + pool_size_ * sizeof(MassInterval);
 }
 
 }  // namespace amytiss::detail

@@ -34,6 +34,11 @@ class RowBounds {
   }
   /// Distinct bounds of dimension d.
   std::size_t distinct_bounds(std::size_t d) const { return distinct_[d].size(); }
+  /// The class of the row's bounds of dimensions d..dims-1 (1 <= d < dims): rows of one class
+  /// have the same bounds in all of them, so the product set's stages d..dims-1 give them the same
+  /// results on the same window line. Classes are numbered 0..suffix_classes(d)-1.
+  std::uint32_t suffix_class(std::size_t row, std::size_t d) const { return suffix_class_[row * dims_ + d]; }
+  std::size_t suffix_classes(std::size_t d) const { return suffix_classes_[d]; }
   /// Mass intervals stored, and bytes in all.
   std::size_t intervals() const { return pool_size_; }
   std::size_t bytes() const;
@@ -42,6 +47,9 @@ class RowBounds {
   std::size_t dims_, inputs_, disturbances_;
   std::vector<std::uint32_t> index_;                 // [row * dims + d]; rows of unneeded cells: 0
   std::vector<std::vector<DimensionView>> distinct_;  // per dimension
+  std::vector<std::uint32_t> suffix_class_;           // [row * dims + d], d >= 1
+  std::vector<std::size_t> suffix_classes_;           // per dimension (0 for d = 0)
+  void number_suffix_classes(const std::vector<bool>& needed);
   std::vector<std::vector<MassInterval>> pools_;      // one per worker; views point into them
   std::size_t pool_size_ = 0;
 };
