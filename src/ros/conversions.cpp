@@ -14,12 +14,13 @@ namespace amytiss_ros {
 namespace {
 
 // The one answer behind both GetInput and InputCommand: on success `input` holds the policy's
-// input and `probability` V_k of the state's cell; otherwise `input` is empty, `probability` 0
-// and `message` says why.
+// input, `probability` V_k of the state's cell and `*upper` (when not null) its upper bound;
+// otherwise `input` is empty, `probability` and `*upper` 0 and `message` says why.
 bool answer_state(const amytiss::Policy* policy, const std::vector<double>& state, unsigned time_step,
                   const std::string& server_notice, std::vector<double>& input, double& probability,
-                  std::string& message) {
+                  double* upper, std::string& message) {
   probability = 0.0;
+  if (upper != nullptr) *upper = 0.0;
   message.clear();
   if (policy == nullptr) {
     input.clear();
@@ -28,7 +29,8 @@ bool answer_state(const amytiss::Policy* policy, const std::vector<double>& stat
   }
   input.resize(policy->inputs.dims());
   double value = 0.0;
-  const amytiss::LookupStatus status = policy->lookup(state.data(), state.size(), time_step, input.data(), &value);
+  const amytiss::LookupStatus status =
+      policy->lookup(state.data(), state.size(), time_step, input.data(), &value, upper);
   if (status != amytiss::LookupStatus::Ok) {
     input.clear();
     message = policy->describe(status, state.data(), state.size(), time_step);
@@ -51,8 +53,10 @@ void fill_get_input_response(const amytiss::Policy* policy, const std::vector<do
                              unsigned time_step, const std::string& server_notice,
                              amytiss::GetInput::Response& response) {
   response.success = answer_state(policy, state, time_step, server_notice, response.input, response.probability,
-                                  response.message);
+                                  &response.probability_upper, response.message);
   name_policy(policy, response);
+  // Both names fit in std::string's inline buffer: no allocation on the request path.
+  response.guarantee = policy ? amytiss::to_string(policy->guarantee) : std::string();
 }
 
 void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamped& state,
@@ -61,7 +65,7 @@ void fill_input_command(const amytiss::Policy* policy, const amytiss::StateStamp
   command.header.frame_id = state.header.frame_id;
   command.time_step = state.time_step;
   command.valid = answer_state(policy, state.state, state.time_step, server_notice, command.input,
-                               command.probability, command.message);
+                               command.probability, nullptr, command.message);
   name_policy(policy, command);
 }
 

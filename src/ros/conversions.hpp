@@ -20,10 +20,11 @@ namespace amytiss_ros {
 
 /// Answers a GetInput request from `policy` (nullptr: no policy loaded yet, answered with
 /// success false and "no policy yet: " + server_notice). On success `input` has the policy's
-/// input dimensions, `probability` is V_k of the state's cell and `message` is server_notice (a
-/// warning such as "synthesizer not running since ...", usually empty); otherwise success is
-/// false, `message` is Policy::describe()'s sentence, `input` is empty and probability 0.
-/// config_hash and run_id name the answering policy (empty without one).
+/// input dimensions, `probability` is V_k of the state's cell, `probability_upper` its upper bound
+/// (Policy::upper_value) and `message` is server_notice (a warning such as "synthesizer not
+/// running since ...", usually empty); otherwise success is false, `message` is
+/// Policy::describe()'s sentence, `input` is empty and both probabilities 0. config_hash, run_id
+/// and guarantee ("abstraction" or "system") name the answering policy (empty without one).
 /// Allocation: only the response's vector and strings (they reuse their capacity).
 void fill_get_input_response(const amytiss::Policy* policy, const std::vector<double>& state,
                              unsigned time_step, const std::string& server_notice,

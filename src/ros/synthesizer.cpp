@@ -258,6 +258,7 @@ void SynthesizerNode::announce(const amytiss::Config& config, const amytiss::Pol
     status.config_hash = amytiss::config_hash(config);
     status.policy_file = outcome.policy_file;
     status.horizon = policy.horizon;
+    status.guarantee = amytiss::to_string(policy.guarantee);
     status.run_id = policy.run_id;
     status.generation += 1;
     if (phase == amytiss::PolicyStatus::PHASE_DONE) status.syntheses_run += 1;

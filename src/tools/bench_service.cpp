@@ -20,6 +20,7 @@
 namespace {
 
 constexpr double kReadyWaitSeconds = 600.0;  // the synthesis of the benchmark's configuration
+constexpr double kAnswerPollSeconds = 0.05;
 
 struct ThreadResult {
   std::vector<double> latencies_us;
@@ -59,6 +60,20 @@ ThreadResult run_client(const amytiss::Policy& policy, std::size_t calls, unsign
   return result;
 }
 
+// Whether the server answers a valid state (the first cell at step 0) with success before
+// `deadline`, asking every kAnswerPollSeconds.
+bool server_answers(ros::NodeHandle& handle, const amytiss::Policy& policy, const ros::WallTime& deadline) {
+  ros::ServiceClient client = handle.serviceClient<amytiss::GetInput>("/amytiss/get_input");
+  amytiss::GetInput service;
+  service.request.state = policy.states.point(0);
+  service.request.time_step = 0;
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    if (client.call(service) && service.response.success) return true;
+    ros::WallDuration(kAnswerPollSeconds).sleep();
+  }
+  return false;
+}
+
 double percentile(const std::vector<double>& sorted, double fraction) {
   const std::size_t index = std::min(sorted.size() - 1, std::size_t(fraction * double(sorted.size())));
   return sorted[index];
@@ -89,6 +104,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   const amytiss::Policy policy = amytiss::read_policy_file(status->policy_file).policy;
+  // The server loads the file after the status arrives: time only the calls it can answer.
+  if (!server_answers(handle, policy, deadline)) {
+    std::fprintf(stderr, "/amytiss/get_input answered no valid state before the deadline\n");
+    return 1;
+  }
 
   std::vector<ThreadResult> results(threads);
   std::vector<std::thread> workers;

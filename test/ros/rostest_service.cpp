@@ -81,6 +81,9 @@ std::string ServiceTest::policy_file_;
 
 TEST_F(ServiceTest, AnswersEqualTheCorePolicyForSampledStates) {
   const amytiss::Policy& policy = loaded_.policy;
+  // tiny_reach_avoid.yaml keeps the default guarantee: exact values of the abstract model.
+  ASSERT_EQ(policy.guarantee, amytiss::Guarantee::Abstraction);
+  EXPECT_EQ(status_.latest().guarantee, "abstraction");
   std::mt19937 random(kRandomSeed);
   std::vector<double> expected_input(policy.inputs.dims());
   for (int sample = 0; sample < kSampledStates; ++sample) {
@@ -98,6 +101,8 @@ TEST_F(ServiceTest, AnswersEqualTheCorePolicyForSampledStates) {
     ASSERT_TRUE(response.success) << response.message;
     EXPECT_EQ(response.input, expected_input);
     EXPECT_EQ(response.probability, expected_probability);
+    EXPECT_EQ(response.probability_upper, response.probability);
+    EXPECT_EQ(response.guarantee, "abstraction");
   }
 }
 

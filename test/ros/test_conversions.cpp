@@ -146,8 +146,48 @@ TEST_F(LookupConversions, ResponseEqualsThePolicyForEveryCellAndStep) {
       policy_->inputs.point(index, expected_input.data());
       ASSERT_EQ(response.input, expected_input);
       ASSERT_EQ(response.probability, policy_->value(step, cell));
+      // A bounded abstraction policy's values are exact for the abstract model: nothing to bound.
+      ASSERT_EQ(response.probability_upper, response.probability);
+      ASSERT_EQ(response.guarantee, "abstraction");
     }
   }
+}
+
+// guarantee: system, built by hand: each (step, cell) has its own lower and upper bound, so an
+// answer from the wrong row, the wrong cell or the lower bound twice is caught.
+TEST(SystemGuaranteeConversions, ResponseCarriesTheLowerAndUpperBoundOfTheCell) {
+  amytiss::Policy policy;
+  policy.states = amytiss::Grid(amytiss::GridSpec{{0.0}, {2.0}, {1.0}});
+  policy.inputs = amytiss::Grid(amytiss::GridSpec{{-1.0}, {1.0}, {2.0}});
+  policy.horizon = 2;
+  policy.guarantee = amytiss::Guarantee::System;
+  const std::size_t cells = policy.states.size();
+  ASSERT_EQ(cells, 3u);
+  policy.roles.assign(cells, amytiss::CellRole::Free);
+  for (unsigned step = 0; step <= policy.horizon; ++step) {
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+      policy.values.push_back(0.1 * (step + 1) + 0.01 * double(cell));
+      policy.upper_values.push_back(0.5 + 0.1 * step + 0.01 * double(cell));
+      if (step < policy.horizon) policy.input_index.push_back(std::uint32_t((step + cell) % 2));
+    }
+  }
+  amytiss::GetInput::Response response;
+  for (unsigned step = 0; step < policy.horizon; ++step) {
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+      amytiss_ros::fill_get_input_response(&policy, policy.states.point(cell), step, "", response);
+      ASSERT_TRUE(response.success) << response.message;
+      EXPECT_EQ(response.probability, policy.values[step * cells + cell]);
+      EXPECT_EQ(response.probability_upper, policy.upper_values[step * cells + cell]);
+      EXPECT_EQ(response.guarantee, "system");
+      EXPECT_EQ(response.input, policy.inputs.point(policy.input(step, cell)));
+    }
+  }
+  // A refused request still names the policy's guarantee, with no probabilities.
+  amytiss_ros::fill_get_input_response(&policy, {1.0}, policy.horizon, "", response);
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.probability, 0.0);
+  EXPECT_EQ(response.probability_upper, 0.0);
+  EXPECT_EQ(response.guarantee, "system");
 }
 
 TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
@@ -164,15 +204,18 @@ TEST_F(LookupConversions, MalformedRequestsGetMessagesAndNoInput) {
   for (const auto& c : cases) {
     amytiss::GetInput::Response response;
     response.input = {42.0};
+    response.probability_upper = 0.5;
     amytiss_ros::fill_get_input_response(policy_, c.state, c.step, "", response);
     EXPECT_FALSE(response.success);
     EXPECT_TRUE(response.input.empty());
     EXPECT_EQ(response.probability, 0.0);
+    EXPECT_EQ(response.probability_upper, 0.0);
     EXPECT_NE(response.message.find(c.expected_word), std::string::npos) << response.message;
   }
 }
 
-// An unbounded specification's stationary policy answers any time_step with its lower bound.
+// An unbounded specification's stationary policy answers any time_step with its lower and upper
+// bound.
 TEST_F(LookupConversions, StationaryPolicyIgnoresTheStep) {
   amytiss::Config config = amytiss::load_config_file(kTinyConfig);
   config.spec.unbounded = true;
@@ -180,24 +223,34 @@ TEST_F(LookupConversions, StationaryPolicyIgnoresTheStep) {
   const amytiss::Policy stationary =
       amytiss::synthesize_reference(amytiss::Abstraction::from_config(config), {});
   ASSERT_TRUE(stationary.stationary);
+  std::size_t cells_with_a_gap = 0;
+  for (std::size_t cell = 0; cell < stationary.states.size(); ++cell)
+    cells_with_a_gap += stationary.upper_values.at(cell) != stationary.value(0, cell);
+  ASSERT_GT(cells_with_a_gap, 0u) << "the upper bounds must differ from the lower ones to be told apart";
   for (unsigned step : {0u, 1u, 57u, 4000000000u}) {
     for (std::size_t cell = 0; cell < stationary.states.size(); ++cell) {
       amytiss::GetInput::Response response;
       amytiss_ros::fill_get_input_response(&stationary, stationary.states.point(cell), step, "", response);
       ASSERT_TRUE(response.success) << response.message;
       ASSERT_EQ(response.probability, stationary.value(0, cell));
+      // The upper bound of the optimal value from the interval iteration, not the lower bound.
+      ASSERT_EQ(response.probability_upper, stationary.upper_values[cell]);
+      ASSERT_EQ(response.guarantee, "abstraction");
     }
   }
 }
 
 TEST_F(LookupConversions, NoPolicyYetSaysWhy) {
   amytiss::GetInput::Response response;
+  amytiss_ros::fill_get_input_response(policy_, {0.0, 0.0}, 0, "", response);  // a previous answer
   amytiss_ros::fill_get_input_response(nullptr, {0.0, 0.0}, 0, "synthesis is running (42%)", response);
   EXPECT_FALSE(response.success);
   EXPECT_EQ(response.message, "no policy yet: synthesis is running (42%)");
   EXPECT_TRUE(response.input.empty());
   EXPECT_EQ(response.config_hash, "");
   EXPECT_EQ(response.run_id, "");
+  EXPECT_EQ(response.guarantee, "");
+  EXPECT_EQ(response.probability_upper, 0.0);
 }
 
 TEST_F(LookupConversions, AnswersNameThePolicyAndCarryTheServerNotice) {
