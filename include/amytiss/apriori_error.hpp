@@ -59,4 +59,8 @@ double noise_density_slope(const Abstraction& abstraction, std::string* why_not)
 /// few as fit (every box holds a Free cell); nothing else.
 AprioriError apriori_error(const Abstraction& abstraction, std::size_t max_jacobians = 0);
 
+/// One line for people: "a-priori error of the abstraction (paper's bound): 6.7e+02, vacuous: T 16 x
+/// H ..." (", vacuous" when epsilon >= 1; the factors, and why a factor is infinite, after the colon).
+std::string describe_apriori_error(const AprioriError& error);
+
 }  // namespace amytiss

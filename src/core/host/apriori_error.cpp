@@ -189,10 +189,11 @@ AprioriError apriori_error(const Abstraction& abstraction, std::size_t max_jacob
 
   std::string why_not;
   error.density_slope = noise_density_slope(abstraction, &why_not);
-  const std::vector<std::size_t> side = box_sides(abstraction, max_jacobians);
-  error.cells_per_box = 1;
-  for (std::size_t cells : side) error.cells_per_box *= cells;
-  if (why_not.empty()) error.jacobian_norm = jacobian_norm_over_free_cells(abstraction, side, &why_not);
+  if (why_not.empty()) {
+    const std::vector<std::size_t> side = box_sides(abstraction, max_jacobians);
+    for (std::size_t cells : side) error.cells_per_box *= cells;
+    error.jacobian_norm = jacobian_norm_over_free_cells(abstraction, side, &why_not);
+  }
   error.lipschitz = why_not.empty() ? error.density_slope * error.jacobian_norm * (1 + kRoundingSlack) : kInfinity;
   if (why_not.empty() && abstraction.unbounded) why_not = "the horizon is infinite";
   error.epsilon = why_not.empty() ? error.horizon * error.lipschitz * error.measure * error.delta * (1 + kRoundingSlack)
@@ -205,6 +206,11 @@ AprioriError apriori_error(const Abstraction& abstraction, std::size_t max_jacob
                       " x delta " + format_significant(error.delta);
   if (!why_not.empty()) error.explanation += "; infinite: " + why_not;
   return error;
+}
+
+std::string describe_apriori_error(const AprioriError& error) {
+  return "a-priori error of the abstraction (paper's bound): " + format_significant(error.epsilon, 2) +
+         (error.vacuous() ? ", vacuous" : "") + ": " + error.explanation;
 }
 
 }  // namespace amytiss
