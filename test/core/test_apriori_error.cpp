@@ -109,7 +109,8 @@ std::vector<double> post(const Abstraction& abstraction, std::vector<double> x, 
 }
 
 // The spectral norm of df/dx at x by central differences.
-double finite_difference_norm(const Abstraction& abstraction, const std::vector<double>& x, const std::vector<double>& u) {
+double finite_difference_norm(const Abstraction& abstraction, const std::vector<double>& x,
+                              const std::vector<double>& u) {
   const std::size_t n = x.size();
   Eigen::MatrixXd jacobian(n, n);
   for (std::size_t j = 0; j < n; ++j) {
@@ -117,7 +118,8 @@ double finite_difference_norm(const Abstraction& abstraction, const std::vector<
     up[j] += kStep;
     down[j] -= kStep;
     const std::vector<double> f_up = post(abstraction, up, u), f_down = post(abstraction, down, u);
-    for (std::size_t i = 0; i < n; ++i) jacobian(Eigen::Index(i), Eigen::Index(j)) = (f_up[i] - f_down[i]) / (2 * kStep);
+    for (std::size_t i = 0; i < n; ++i)
+      jacobian(Eigen::Index(i), Eigen::Index(j)) = (f_up[i] - f_down[i]) / (2 * kStep);
   }
   return Eigen::JacobiSVD<Eigen::MatrixXd>(jacobian).singularValues()(0);
 }
@@ -175,8 +177,9 @@ TEST(AprioriError, RobotReachAvoidIsVacuous) {
   const double slope = std::exp(-0.5) / (std::sqrt(0.75) * 2 * M_PI * 0.75);
   EXPECT_NEAR(error.epsilon, 16 * slope * 400 * std::sqrt(0.5), kHandAgreement * error.epsilon);
   EXPECT_TRUE(error.vacuous());
-  EXPECT_EQ(describe_apriori_error(error).rfind("a-priori error of the abstraction (paper's bound): 6.7e+02, vacuous: T 16 x H ", 0), 0u)
-      << describe_apriori_error(error);
+  const std::string line = describe_apriori_error(error);
+  EXPECT_EQ(line.rfind("a-priori error of the abstraction (paper's bound): 6.7e+02, vacuous: T 16 x H ", 0), 0u)
+      << line;
   std::cout << "robot_reach_avoid: epsilon " << error.epsilon << " (" << error.explanation << ") in " << seconds
             << " s\n";
 }

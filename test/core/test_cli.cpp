@@ -130,9 +130,10 @@ TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
   ASSERT_EQ(0, result.exit_code) << result.out << result.err;
   const LoadedPolicy loaded = read_policy_file_for(path("system.h5"), load_config_file(path("tiny_system.yaml")));
   if (loaded.policy.guarantee != Guarantee::System) GTEST_SKIP() << "the engine computed no continuous-system bounds";
-  for (const char* line : {"continuous-system bounds over", "lower (V_0, this policy) min", "upper (any controller)   min",
-                           "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
-                           "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "})
+  for (const char* line :
+       {"continuous-system bounds over", "lower (V_0, this policy) min", "upper (any controller)   min",
+        "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
+        "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "})
     EXPECT_CONTAINS(result.out, line);
 }
 

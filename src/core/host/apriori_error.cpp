@@ -29,7 +29,8 @@ std::vector<double> covariance_eigenvalues_from_below(const NoiseConfig& noise, 
   Eigen::MatrixXd matrix(n, n);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j) matrix(Eigen::Index(i), Eigen::Index(j)) = noise.covariance[i * n + j];
-  const Eigen::VectorXd values = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(matrix, Eigen::EigenvaluesOnly).eigenvalues();
+  const Eigen::VectorXd values =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(matrix, Eigen::EigenvaluesOnly).eigenvalues();
   const double largest = values.cwiseAbs().maxCoeff();
   std::vector<double> lowered;
   for (Eigen::Index i = 0; i < values.size(); ++i) lowered.push_back(values(i) - kEigenvalueSlack * largest);
@@ -102,7 +103,8 @@ std::vector<IntervalBox> boxes_with_free_cells(const Abstraction& abstraction, c
       const std::size_t first = (rest % boxes_along[d]) * side[d];
       const std::size_t last = std::min(first + side[d], states.count(d)) - 1;
       const double lb = states.lb()[d], eta = states.eta()[d];
-      interval_box[d] = Interval(round_down(lb + (double(first) - 0.5) * eta), round_up(lb + (double(last) + 0.5) * eta));
+      interval_box[d] =
+          Interval(round_down(lb + (double(first) - 0.5) * eta), round_up(lb + (double(last) + 0.5) * eta));
     }
     result.push_back(std::move(interval_box));
   }
@@ -111,7 +113,8 @@ std::vector<IntervalBox> boxes_with_free_cells(const Abstraction& abstraction, c
 
 std::string box_text(const IntervalBox& box) {
   std::string text;
-  for (const Interval& side : box) text += (text.empty() ? "" : " x ") + ("[" + format_significant(side.lo) + ", " + format_significant(side.hi) + "]");
+  for (const Interval& side : box)
+    text += (text.empty() ? "[" : " x [") + format_significant(side.lo) + ", " + format_significant(side.hi) + "]";
   return text;
 }
 
@@ -154,10 +157,18 @@ double noise_density_slope(const Abstraction& abstraction, std::string* why_not)
   }
   switch (noise.distribution) {
     case Distribution::Normal: break;
-    case Distribution::Uniform: *why_not = "uniform noise: its density jumps at the support's ends, not Lipschitz"; return kInfinity;
-    case Distribution::Exponential: *why_not = "exponential noise: its density jumps at the shift, not Lipschitz"; return kInfinity;
-    case Distribution::Beta: *why_not = "beta noise: no Lipschitz bound of its density is computed here"; return kInfinity;
-    case Distribution::Custom: *why_not = "custom noise density: no Lipschitz bound is computed here"; return kInfinity;
+    case Distribution::Uniform:
+      *why_not = "uniform noise: its density jumps at the support's ends, not Lipschitz";
+      return kInfinity;
+    case Distribution::Exponential:
+      *why_not = "exponential noise: its density jumps at the shift, not Lipschitz";
+      return kInfinity;
+    case Distribution::Beta:
+      *why_not = "beta noise: no Lipschitz bound of its density is computed here";
+      return kInfinity;
+    case Distribution::Custom:
+      *why_not = "custom noise density: no Lipschitz bound is computed here";
+      return kInfinity;
   }
   // N(y; 0, Sigma): grad = -Sigma^-1 y N(y). With z = Sigma^-1/2 y, |Sigma^-1 y| <= |z| / sqrt(lambda_min)
   // and |z| exp(-|z|^2/2) <= exp(-1/2) (at |z| = 1, along the smallest eigenvector: attained), so
@@ -201,7 +212,8 @@ AprioriError apriori_error(const Abstraction& abstraction, std::size_t max_jacob
   error.explanation = "T " + format_significant(error.horizon) + " x H " + format_significant(error.lipschitz) +
                       " (density slope " + format_significant(error.density_slope) + " x |df/dx| " +
                       format_significant(error.jacobian_norm) +
-                      (error.cells_per_box > 1 ? " over boxes of " + std::to_string(error.cells_per_box) + " cells" : "") +
+                      (error.cells_per_box > 1 ? " over boxes of " + std::to_string(error.cells_per_box) + " cells"
+                                               : "") +
                       ") x L(A) " + format_significant(error.measure) +
                       " x delta " + format_significant(error.delta);
   if (!why_not.empty()) error.explanation += "; infinite: " + why_not;
