@@ -118,6 +118,29 @@ TEST_F(CliTest, PrintsThePapersAprioriError) {
   EXPECT_CONTAINS(result.out, "a-priori error of the abstraction (paper's bound): 4.7e+02, vacuous: T 4 x H ");
 }
 
+// An unbounded specification's policy has upper bounds: --compare-reference reports the largest
+// difference of each bound (the same engine twice: none).
+TEST_F(CliTest, CompareReferenceComparesBothBoundsOfAnUnboundedPolicy) {
+  std::ifstream tiny(kTinyConfig);
+  std::stringstream text;
+  text << tiny.rdbuf();
+  std::string yaml = text.str();
+  const std::string horizon = "horizon: 4";
+  ASSERT_NE(yaml.find(horizon), std::string::npos);
+  yaml.replace(yaml.find(horizon), horizon.size(), "horizon: infinite");
+  std::ofstream(path("tiny_unbounded.yaml")) << yaml;
+  const CommandResult result =
+      synth("--config " + quote(path("tiny_unbounded.yaml")) + " --device reference --quiet --compare-reference");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "paper's bound): inf, vacuous");
+  for (const std::string marker :
+       {"max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "}) {
+    const std::size_t at = result.out.find(marker);
+    ASSERT_NE(std::string::npos, at) << result.out;
+    EXPECT_LE(std::stod(result.out.substr(at + marker.size())), kSameEngineTolerance) << marker;
+  }
+}
+
 // guarantee: system prints both bounds, their gap and, with --compare-reference, how far each bound
 // is from the reference engine's. Skipped while the engines compute no continuous-system bounds.
 TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
