@@ -78,6 +78,18 @@ struct ValueSummary {
 };
 ValueSummary summarize_initial_values(const Policy& policy);
 
+/// min, mean and max of a quantity over the Free cells (probabilities; 0 when there is none).
+struct RangeSummary {
+  double min = 0, mean = 0, max = 0;
+};
+/// Both bounds of step 0 over the Free cells: lower, value(0, cell); upper, upper_value(0, cell);
+/// gap, upper - lower per cell. Without upper bounds (abstraction, bounded) upper equals lower.
+struct BoundsSummary {
+  RangeSummary lower, upper, gap;
+  std::size_t free_cells = 0;
+};
+BoundsSummary summarize_bounds(const Policy& policy);
+
 /// A fresh random run id (16 lowercase hex digits) from std::random_device.
 std::string new_run_id();
 

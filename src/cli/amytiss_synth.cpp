@@ -99,6 +99,7 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   std::printf("  %-24s %s\n", "file write", format_seconds(write_seconds).c_str());
   if (options.profile) print_profile(report);
   print_value_summary(policy);
+  if (mpi.rank() == 0) print_apriori_error(abstraction);
   if (options.compare_reference) {
     const double engine_compute_seconds = report.phases.empty() ? synthesis_wall_seconds : compute_seconds(report);
     compare_with_reference(abstraction, policy, synthesis_wall_seconds, engine_compute_seconds, quiet);

@@ -26,9 +26,13 @@ double compute_seconds(const SynthesisReport& report);
 void print_phase_times(const SynthesisReport& report);
 /// Per phase: seconds, pairs/s, multiply-adds, GMAC/s, share of the peak, GB/s; and the memory.
 void print_profile(const SynthesisReport& report);
-/// V_0 over the free cells (unbounded: also the upper bound and the gap).
+/// V_0 over the free cells; continuous-system bounds: min, mean and max of the lower bound, the
+/// upper bound and the gap; unbounded: also the upper bound and the gap.
 void print_value_summary(const Policy& policy);
-/// Runs the reference engine too and prints the speed-up and max |dV_0|.
+/// The paper's a-priori error of the abstraction (apriori_error.hpp), its Jacobians bounded in number.
+void print_apriori_error(const Abstraction& abstraction);
+/// Runs the reference engine too and prints the speed-up and max |dV_0| (with upper bounds: the
+/// largest difference of the lower and of the upper bounds).
 void compare_with_reference(const Abstraction& abstraction, const Policy& policy, double engine_seconds,
                             double engine_compute_seconds, bool quiet);
 /// Each rank's synthesis time and the share of it spent exchanging parts. Collective.

@@ -110,6 +110,56 @@ TEST_F(CliTest, CompareReferencePrintsSpeedUpAndDifference) {
   EXPECT_LE(std::stod(result.out.substr(at + marker.size())), kSameEngineTolerance);
 }
 
+// The paper's a-priori error beside the abstraction's values: 4.7e+02 on the tiny problem (T 4,
+// H 1.08, L(A) 77, delta 1.41): vacuous.
+TEST_F(CliTest, PrintsThePapersAprioriError) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device reference --quiet");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "a-priori error of the abstraction (paper's bound): 4.7e+02, vacuous: T 4 x H ");
+}
+
+// An unbounded specification's policy has upper bounds: --compare-reference reports the largest
+// difference of each bound (the same engine twice: none).
+TEST_F(CliTest, CompareReferenceComparesBothBoundsOfAnUnboundedPolicy) {
+  std::ifstream tiny(kTinyConfig);
+  std::stringstream text;
+  text << tiny.rdbuf();
+  std::string yaml = text.str();
+  const std::string horizon = "horizon: 4";
+  ASSERT_NE(yaml.find(horizon), std::string::npos);
+  yaml.replace(yaml.find(horizon), horizon.size(), "horizon: infinite");
+  std::ofstream(path("tiny_unbounded.yaml")) << yaml;
+  const CommandResult result =
+      synth("--config " + quote(path("tiny_unbounded.yaml")) + " --device reference --quiet --compare-reference");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "paper's bound): inf, vacuous");
+  for (const std::string marker :
+       {"max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "}) {
+    const std::size_t at = result.out.find(marker);
+    ASSERT_NE(std::string::npos, at) << result.out;
+    EXPECT_LE(std::stod(result.out.substr(at + marker.size())), kSameEngineTolerance) << marker;
+  }
+}
+
+// guarantee: system prints both bounds, their gap and, with --compare-reference, how far each bound
+// is from the reference engine's. Skipped while the engines compute no continuous-system bounds.
+TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
+  std::ifstream tiny(kTinyConfig);
+  std::stringstream text;
+  text << tiny.rdbuf() << "guarantee: system\n";
+  std::ofstream(path("tiny_system.yaml")) << text.str();
+  const CommandResult result = synth("--config " + quote(path("tiny_system.yaml")) +
+                                     " --device reference --quiet --compare-reference --output system.h5");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  const LoadedPolicy loaded = read_policy_file_for(path("system.h5"), load_config_file(path("tiny_system.yaml")));
+  if (loaded.policy.guarantee != Guarantee::System) GTEST_SKIP() << "the engine computed no continuous-system bounds";
+  for (const char* line :
+       {"continuous-system bounds over", "lower (V_0, this policy) min", "upper (any controller)   min",
+        "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
+        "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "})
+    EXPECT_CONTAINS(result.out, line);
+}
+
 TEST_F(CliTest, BadConfigurationExitsTwoNamingTheKey) {
   const CommandResult result = synth("--config " + quote(kBadEtaConfig));
   EXPECT_EQ(2, result.exit_code) << result.out << result.err;

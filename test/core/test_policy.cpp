@@ -122,5 +122,35 @@ TEST(PolicySummary, InitialValuesOverFreeCells) {
   EXPECT_EQ(summary.cells_at_least_half, 1u);
 }
 
+// Continuous-system bounds: lower and upper bound of step 0 and their gap over the Free cells only.
+TEST(PolicySummary, BoundsOverFreeCells) {
+  Policy policy;
+  policy.states = Grid(grid_spec({0}, {3}, {1}));
+  policy.horizon = 1;
+  policy.guarantee = Guarantee::System;
+  policy.values = {0.2, 0.6, 1.0, 0.0, /* step 1 */ 1, 1, 1, 0};
+  policy.upper_values = {0.5, 0.7, 1.0, 0.0, /* step 1 */ 1, 1, 1, 0};
+  policy.input_index = {0, 0, 0, 0};
+  policy.roles = {CellRole::Free, CellRole::Free, CellRole::FixedOne, CellRole::FixedZero};
+  const BoundsSummary summary = summarize_bounds(policy);
+  EXPECT_EQ(summary.free_cells, 2u);
+  EXPECT_DOUBLE_EQ(summary.lower.min, 0.2);
+  EXPECT_DOUBLE_EQ(summary.lower.mean, 0.4);
+  EXPECT_DOUBLE_EQ(summary.lower.max, 0.6);
+  EXPECT_DOUBLE_EQ(summary.upper.min, 0.5);
+  EXPECT_DOUBLE_EQ(summary.upper.mean, 0.6);
+  EXPECT_DOUBLE_EQ(summary.upper.max, 0.7);
+  EXPECT_DOUBLE_EQ(summary.gap.min, 0.7 - 0.6);
+  EXPECT_DOUBLE_EQ(summary.gap.mean, 0.2);
+  EXPECT_DOUBLE_EQ(summary.gap.max, 0.5 - 0.2);
+
+  // Without upper bounds the upper bound is the value and the gap 0.
+  policy.guarantee = Guarantee::Abstraction;
+  policy.upper_values.clear();
+  const BoundsSummary exact = summarize_bounds(policy);
+  EXPECT_DOUBLE_EQ(exact.upper.mean, exact.lower.mean);
+  EXPECT_DOUBLE_EQ(exact.gap.max, 0.0);
+}
+
 }  // namespace
 }  // namespace amytiss

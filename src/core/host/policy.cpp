@@ -110,6 +110,27 @@ ValueSummary summarize_initial_values(const Policy& policy) {
   return summary;
 }
 
+BoundsSummary summarize_bounds(const Policy& policy) {
+  BoundsSummary summary;
+  RangeSummary* ranges[] = {&summary.lower, &summary.upper, &summary.gap};
+  double sums[3] = {0, 0, 0};
+  for (std::size_t cell = 0; cell < policy.states.size(); ++cell) {
+    if (cell < policy.roles.size() && policy.roles[cell] != CellRole::Free) continue;
+    const double lower = policy.value(0, cell), upper = policy.upper_value(0, cell);
+    const double values[3] = {lower, upper, upper - lower};
+    for (int k = 0; k < 3; ++k) {
+      RangeSummary& range = *ranges[k];
+      range.min = summary.free_cells ? std::min(range.min, values[k]) : values[k];
+      range.max = summary.free_cells ? std::max(range.max, values[k]) : values[k];
+      sums[k] += values[k];
+    }
+    ++summary.free_cells;
+  }
+  if (summary.free_cells)
+    for (int k = 0; k < 3; ++k) ranges[k]->mean = sums[k] / double(summary.free_cells);
+  return summary;
+}
+
 std::string new_run_id() {
   std::random_device device;
   const std::uint64_t id = (std::uint64_t(device()) << 32) ^ std::uint64_t(device());
