@@ -42,6 +42,13 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
   SynthesisReport local_report;
   SynthesisReport& rep = report ? *report : local_report;
   rep.phases.clear();
+  if (abstraction.config.guarantee == Guarantee::System) {
+    SynthesisOptions options;
+    options.compute.device = DeviceKind::Reference;
+    options.progress = progress;
+    detail::SynthesisPlan plan = detail::plan_synthesis(abstraction, options);
+    return detail::carry_out(abstraction, plan, options, {}, rep);
+  }
   return detail::run_reference(abstraction, progress, rep);
 }
 
