@@ -62,4 +62,8 @@ if(CATKIN_ENABLE_TESTING)
         AMYTISS_POLICY_SERVER_BIN="$<TARGET_FILE:policy_server>")
     endif()
   endforeach()
+  # The service test again, on a policy of continuous-system bounds (guarantee: system).
+  if(TARGET amytiss_rostest_service)
+    add_rostest(test/ros/service_system.test DEPENDENCIES amytiss_rostest_service)
+  endif()
 endif()
