@@ -107,6 +107,15 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
     }
     return true;
   };
+  // A union: inside one of its boxes (sufficient for inside the union, so a cell covered only by
+  // several boxes together counts as not inside: the bounds stay sound, a little looser); meets
+  // one of its boxes (exactly: meets the union).
+  auto inside_region = [&](const Region& region) {
+    return std::any_of(region.boxes.begin(), region.boxes.end(), inside);
+  };
+  auto meets_region = [&](const Region& region) {
+    return std::any_of(region.boxes.begin(), region.boxes.end(), meets);
+  };
   const bool lower = bound == Bound::Lower;
   std::vector<CellRole> roles(states.size(), CellRole::Free);
   for (std::size_t cell = 0; cell < states.size(); ++cell) {
@@ -116,11 +125,11 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
       cell_hi[d] = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
     }
     if (spec.type == SpecType::Safety) {
-      if (spec.safe && !(lower ? inside(*spec.safe) : meets(*spec.safe))) roles[cell] = CellRole::FixedZero;
+      if (spec.safe && !(lower ? inside_region(*spec.safe) : meets_region(*spec.safe))) roles[cell] = CellRole::FixedZero;
       continue;
     }
-    if (spec.avoid && (lower ? meets(*spec.avoid) : inside(*spec.avoid))) roles[cell] = CellRole::FixedZero;
-    else if (spec.target && (lower ? inside(*spec.target) : meets(*spec.target))) roles[cell] = CellRole::FixedOne;
+    if (spec.avoid && (lower ? meets_region(*spec.avoid) : inside_region(*spec.avoid))) roles[cell] = CellRole::FixedZero;
+    else if (spec.target && (lower ? inside_region(*spec.target) : meets_region(*spec.target))) roles[cell] = CellRole::FixedOne;
   }
   return roles;
 }
