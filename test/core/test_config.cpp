@@ -477,8 +477,9 @@ TEST(Config, SetsAreABoxOrAListOfBoxes) {
 
 TEST(Config, SetErrorsNameTheBox) {
   YAML::Node root = base();
-  root["spec"] = YAML::Load("{type: reach_avoid, horizon: 4, target: {lb: [5, 5], ub: [7, 7]},"
-                            " avoid: [{lb: [-2, -2], ub: [2, 2]}, {lb: [-9, -9], ub: [-8, -8]}, {lb: [8, -9], ub: [9]}]}");
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: {lb: [5, 5], ub: [7, 7]},"
+      " avoid: [{lb: [-2, -2], ub: [2, 2]}, {lb: [-9, -9], ub: [-8, -8]}, {lb: [8, -9], ub: [9]}]}");
   expect_error(root, "spec.avoid[2].ub", "got 1 values, expected 2 values");
   root["spec"]["avoid"][2] = YAML::Load("{lb: [8, -9], ub: [9, -10]}");
   expect_error(root, "spec.avoid[2].ub[1]", "expected a number >= spec.avoid[2].lb[1] = -9");
@@ -499,7 +500,8 @@ TEST(Config, SetErrorsNameTheBox) {
   root["spec"]["safe"] = YAML::Load("[{lb: [-10, -10], ub: [0, 10]}, {lb: [-30, -30], ub: [-20, -20]}]");
   expect_error(root, "spec.safe[1]", "contains no representative point");
   root = base();
-  root["spec"] = YAML::Load("{type: reachability, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [5], ub: [7, 7]}]}");
+  root["spec"] =
+      YAML::Load("{type: reachability, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [5], ub: [7, 7]}]}");
   expect_error(root, "spec.target[1].lb", "got 1 values, expected 2 values");
 }
 
@@ -509,11 +511,13 @@ TEST(Config, EveryTargetAndAvoidBoxPairMustShareNoGridPoint) {
   root["spec"] = YAML::Load(
       "{type: reach_avoid, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, -7], ub: [-5, -5]}],"
       " avoid: [{lb: [0, 0], ub: [1, 1]}, {lb: [6.6, 4], ub: [8, 5.2]}]}");
-  expect_error(root, "spec.avoid[1]", "and the target box spec.target[0] [5, 5] .. [7, 7] share grid points, for example [7, 5]");
+  expect_error(root, "spec.avoid[1]",
+               "and the target box spec.target[0] [5, 5] .. [7, 7] share grid points, for example [7, 5]");
   // A single avoid box against the second of two targets.
   root["spec"]["avoid"] = YAML::Load("{lb: [-5, -5], ub: [-4, -4]}");
   expect_error(root, "spec.avoid", "the avoid box [-5, -5] .. [-4, -4] and the target box spec.target[1] [-7, -7]");
-  root["spec"]["avoid"] = YAML::Load("[{lb: [0, 0], ub: [1, 1]}, {lb: [7.1, 4], ub: [8, 5.2]}, {lb: [-4.9, -5], ub: [-4, -4]}]");
+  root["spec"]["avoid"] =
+      YAML::Load("[{lb: [0, 0], ub: [1, 1]}, {lb: [7.1, 4], ub: [8, 5.2]}, {lb: [-4.9, -5], ub: [-4, -4]}]");
   EXPECT_NO_THROW(config_from_yaml(root));
 }
 

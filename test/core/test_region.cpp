@@ -62,7 +62,8 @@ TEST(RegionRoles, AbstractionCellIsInAUnionWhenItsPointIsInOneBox) {
   EXPECT_EQ(fixed_one, 4u + 4u);
   EXPECT_EQ(fixed_zero, 1u + 4u + 2u);
 
-  const std::vector<CellRole> safety = cell_roles(grid, safety_spec(1, region({box({0, 0}, {1, 4}), box({3, 0}, {4, 0})})));
+  const std::vector<CellRole> safety =
+      cell_roles(grid, safety_spec(1, region({box({0, 0}, {1, 4}), box({3, 0}, {4, 0})})));
   EXPECT_EQ(std::count(safety.begin(), safety.end(), CellRole::Free), 10 + 2);
   EXPECT_EQ(safety[grid.flat_index(std::vector<std::size_t>{3, 0}.data())], CellRole::Free);
   EXPECT_EQ(safety[grid.flat_index(std::vector<std::size_t>{3, 1}.data())], CellRole::FixedZero);

@@ -234,7 +234,8 @@ void check_spec(const SpecConfig& spec, const GridSpec& states) {
     case SpecType::ReachAvoid:
       if (spec.safe) throw ConfigError("spec.safe", "given for spec.type " + to_string(spec.type) + "; `safe` is for safety only");
       if (!spec.target)
-        throw ConfigError("spec.target", "missing, expected the target box for " + to_string(spec.type) +
+        throw ConfigError("spec.target", "missing, expected the target box (or a list of boxes) for " +
+                                             to_string(spec.type) +
                                              " (example: target: {lb: [5, 5], ub: [7, 7]})");
       check_region(*spec.target, "spec.target", states);
       if (spec.avoid) {

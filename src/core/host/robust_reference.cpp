@@ -125,11 +125,14 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
       cell_hi[d] = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
     }
     if (spec.type == SpecType::Safety) {
-      if (spec.safe && !(lower ? inside_region(*spec.safe) : meets_region(*spec.safe))) roles[cell] = CellRole::FixedZero;
+      if (spec.safe && !(lower ? inside_region(*spec.safe) : meets_region(*spec.safe)))
+        roles[cell] = CellRole::FixedZero;
       continue;
     }
-    if (spec.avoid && (lower ? meets_region(*spec.avoid) : inside_region(*spec.avoid))) roles[cell] = CellRole::FixedZero;
-    else if (spec.target && (lower ? inside_region(*spec.target) : meets_region(*spec.target))) roles[cell] = CellRole::FixedOne;
+    if (spec.avoid && (lower ? meets_region(*spec.avoid) : inside_region(*spec.avoid)))
+      roles[cell] = CellRole::FixedZero;
+    else if (spec.target && (lower ? inside_region(*spec.target) : meets_region(*spec.target)))
+      roles[cell] = CellRole::FixedOne;
   }
   return roles;
 }
