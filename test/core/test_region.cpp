@@ -83,26 +83,44 @@ std::vector<std::size_t> cells_with(const std::vector<CellRole>& roles, CellRole
 
 using Cells = std::vector<std::size_t>;
 
-TEST(RegionRoles, SystemLowerBoundNeedsOneBoxAroundTheCellUpperBoundAnyBoxMeetingIt) {
-  // Target: cells 1, 2 inside the first box; cell 3 meets the second box but sticks out; cell 5 is
-  // covered by the last two boxes together but lies in neither alone (the documented sufficient
-  // test: not a target for the lower bound). Avoid: cell 7 meets [7.2, 7.4], cell 6 lies inside.
+TEST(RegionRoles, SystemLowerBoundNeedsTheCellInsideTheUnionUpperBoundAnyBoxMeetingIt) {
+  // Target: cells 1, 2 inside the first box; cell 3 meets the second box but sticks out; cell 5
+  // lies in the last two boxes together (in neither alone). Avoid: cell 7 meets [7.2, 7.4];
+  // cell 6 lies in the union of the first two avoid boxes.
   const SpecConfig spec = reach_avoid_spec(
       1, region({box({0.5}, {2.5}), box({2.5}, {3.2}), box({4.5}, {5.0}), box({5.0}, {5.5})}),
       region({box({5.6}, {6.5}), box({5.5}, {6.0}), box({7.2}, {7.4})}));
   const std::vector<CellRole> lower = robust_roles(spec, Bound::Lower), upper = robust_roles(spec, Bound::Upper);
-  EXPECT_EQ(cells_with(lower, CellRole::FixedOne), (Cells{1, 2}));
+  EXPECT_EQ(cells_with(lower, CellRole::FixedOne), (Cells{1, 2, 5}));
   EXPECT_EQ(cells_with(upper, CellRole::FixedOne), (Cells{1, 2, 3, 5}));
   EXPECT_EQ(cells_with(lower, CellRole::FixedZero), (Cells{6, 7}));
-  EXPECT_EQ(cells_with(upper, CellRole::FixedZero), (Cells{}));  // cell 6 is inside no single avoid box
+  EXPECT_EQ(cells_with(upper, CellRole::FixedZero), (Cells{6}));
 
-  const SpecConfig avoid_inside = reach_avoid_spec(1, box({0.5}, {1.5}), region({box({6.5}, {7.2}), box({5.5}, {6.5})}));
-  EXPECT_EQ(cells_with(robust_roles(avoid_inside, Bound::Upper), CellRole::FixedZero), (Cells{6}));
+  // A gap between two boxes (wider than the face tolerance) leaves the cell outside the union.
+  const SpecConfig gap = reach_avoid_spec(1, region({box({4.5}, {4.99}), box({5.0}, {5.5})}));
+  EXPECT_EQ(cells_with(robust_roles(gap, Bound::Lower), CellRole::FixedOne), (Cells{}));
+  EXPECT_EQ(cells_with(robust_roles(gap, Bound::Upper), CellRole::FixedOne), (Cells{5}));
 
-  // Safety: lower keeps the cells inside one safe box, upper those meeting one.
-  const SpecConfig safety = safety_spec(1, region({box({-0.5}, {2.5}), box({4.5}, {5.0})}));
+  // Safety: lower keeps the cells inside the union, upper those meeting one of its boxes.
+  const SpecConfig safety = safety_spec(1, region({box({-0.5}, {2.5}), box({2.5}, {3.0}), box({4.5}, {5.0})}));
   EXPECT_EQ(cells_with(robust_roles(safety, Bound::Lower), CellRole::Free), (Cells{0, 1, 2}));
-  EXPECT_EQ(cells_with(robust_roles(safety, Bound::Upper), CellRole::Free), (Cells{0, 1, 2, 5}));
+  EXPECT_EQ(cells_with(robust_roles(safety, Bound::Upper), CellRole::Free), (Cells{0, 1, 2, 3, 5}));
+}
+
+TEST(RegionRoles, ACellCoveredByAnLShapeAndABoxIsInsideInEveryOrder) {
+  // The cell of the point (0, 0) with eta 1 is [-0.5, 0.5]^2: a left half, a lower right and an
+  // upper right quarter cover it; without the upper right quarter they do not.
+  const Grid grid(grid_spec({0, 0}, {2, 2}, {1, 1}));
+  std::vector<Box> pieces{box({-0.5, -0.5}, {0, 0.5}), box({0, -0.5}, {0.5, 0}), box({0, 0}, {0.5, 0.5})};
+  for (int order = 0; order < 3; ++order) {
+    std::rotate(pieces.begin(), pieces.begin() + 1, pieces.end());
+    const std::vector<CellRole> whole =
+        robust_cell_roles(grid, reach_avoid_spec(1, region(pieces)), Bound::Lower);
+    EXPECT_EQ(cells_with(whole, CellRole::FixedOne), (Cells{0})) << "order " << order;
+    const std::vector<Box> missing(pieces.begin(), pieces.begin() + 2);
+    const std::vector<CellRole> part = robust_cell_roles(grid, reach_avoid_spec(1, region(missing)), Bound::Lower);
+    EXPECT_EQ(cells_with(part, CellRole::FixedOne), (Cells{})) << "order " << order;
+  }
 }
 
 // A chain x' = x + u + v on the points 0..8, u in {-1, 0, 1}, v uniform on [-1, 1]: from the post
