@@ -7,8 +7,8 @@
                    [--scene SCENE.yaml]
 
 OUT1: the episodes' trajectories over the sets in the x0/x1 plane (success green, failure red),
-with the grid bounds, target (green), avoid (red) and safe (blue) boxes from the configuration
-stored in the policy file. With --footprint (a car: metres, the state coordinates of its reference
+with the grid bounds, target (green), avoid (red) and safe (blue) boxes (every box of a set that
+is a list of boxes) from the configuration stored in the policy file. With --footprint (a car: metres, the state coordinates of its reference
 point and yaw) the car's body is drawn at every step of every episode; with --scene the picture's
 scene (config/bmw_parking_scene.yaml: the bay, parked cars and kerbs, metres) is drawn under it,
 and every footprint is checked against the scene's obstacles (the result is printed and in the
@@ -115,6 +115,11 @@ def box_xy(box):
     return lb[0], y0, ub[0] - lb[0], y1 - y0
 
 
+def boxes_of(region):
+    """The boxes of a specification set: one box {lb, ub} or a list of boxes."""
+    return region if isinstance(region, list) else [region]
+
+
 def draw_sets(ax, policy, suffix=""):
     lb, eta, counts = policy["lb"], policy["eta"], policy["counts"]
     lo = lb - eta / 2
@@ -125,9 +130,10 @@ def draw_sets(ax, policy, suffix=""):
     styles = {"target": dict(fc="tab:green", alpha=0.35), "avoid": dict(fc="tab:red", alpha=0.35),
               "safe": dict(fill=False, ec="tab:blue", lw=1.5)}
     for name, style in styles.items():
-        if spec.get(name):
-            x, y, w, h = box_xy(spec[name])
-            ax.add_patch(Rectangle((x, y), w, h, label=name + suffix, **style))
+        for index, box in enumerate(boxes_of(spec.get(name) or [])):
+            x, y, w, h = box_xy(box)
+            # One legend entry per set, not per box.
+            ax.add_patch(Rectangle((x, y), w, h, label=name + suffix if index == 0 else None, **style))
     ax.set_xlim(lo[0] - eta[0], hi[0] + eta[0])
     ax.set_ylim(y0 - (eta[1] if len(eta) > 1 else 0.5), y1 + (eta[1] if len(eta) > 1 else 0.5))
 

@@ -51,12 +51,12 @@ struct Abstraction {
   std::size_t triples() const { return pairs() * disturbances.size(); }
 };
 
-/// Roles of the state cells for a specification (a cell is in a set when its point lies in the
-/// closed box). Safety: outside `safe` -> FixedZero (no `safe`: all Free). Reachability: target ->
+/// Roles of the state cells for a specification (a cell is in a set when its point lies in one of
+/// the set's closed boxes). Safety: outside `safe` -> FixedZero (no `safe`: all Free). Reachability: target ->
 /// FixedOne. Reach-avoid: avoid -> FixedZero, target -> FixedOne; a cell in both (a configuration
 /// error that validate() rejects) is FixedZero: avoid is applied first and wins.
-/// Throws std::logic_error for a missing target or a box of the wrong dimension (validate()
-/// refuses both).
+/// Throws std::logic_error for a missing target, a set without boxes or a box of the wrong
+/// dimension (validate() refuses them).
 std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec);
 
 }  // namespace amytiss

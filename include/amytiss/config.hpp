@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -15,6 +16,16 @@ namespace amytiss {
 struct Box {
   std::vector<double> lb;
   std::vector<double> ub;
+};
+
+/// A set of the specification: a union of axis-aligned boxes, given as one box {lb, ub} or a list
+/// of boxes [{lb, ub}, {lb, ub}] (docs/configuration.md). A point belongs to it when it lies in one
+/// of its boxes. A list of one box is the same set as that box, and prints as the box.
+struct Region {
+  std::vector<Box> boxes;  ///< at least one after validate(); units of the state space
+  Region() = default;
+  Region(Box box) : boxes{std::move(box)} {}  // NOLINT(google-explicit-constructor): a box is a region
+  explicit Region(std::vector<Box> list) : boxes(std::move(list)) {}
 };
 
 /// A uniform grid over a box: points lb + k*eta, k = 0..n-1, n = floor((ub-lb)/eta + 0.5) + 1.
@@ -92,9 +103,9 @@ struct SpecConfig {
   std::optional<double> tolerance;
   static constexpr double kDefaultTolerance = 1e-6;
   double tolerance_or_default() const { return tolerance.value_or(kDefaultTolerance); }
-  std::optional<Box> safe;    ///< safety; absent: the whole grid
-  std::optional<Box> target;  ///< reachability, reach_avoid
-  std::optional<Box> avoid;   ///< reach_avoid (absent: empty)
+  std::optional<Region> safe;    ///< safety; absent: the whole grid
+  std::optional<Region> target;  ///< reachability, reach_avoid
+  std::optional<Region> avoid;   ///< reach_avoid (absent: empty)
 };
 
 enum class DeviceKind { Auto, Cpu, Gpu, Reference };

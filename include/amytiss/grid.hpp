@@ -42,6 +42,8 @@ class Grid {
   std::optional<std::size_t> cell_of(const double* state) const;
   /// Whether the point of flat index lies in the closed box (coordinate_in_box, grid_rules.hpp).
   bool point_in_box(std::size_t flat, const Box& box) const;
+  /// Whether the point of flat index lies in one of the region's boxes (point_in_box).
+  bool point_in_region(std::size_t flat, const Region& region) const;
 
  private:
   std::vector<double> lb_, eta_;

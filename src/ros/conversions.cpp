@@ -177,14 +177,23 @@ visualization_msgs::Marker make_car_marker(const std::vector<double>& state, con
 
 namespace {
 
-std::optional<amytiss::Box> stored_box(const YAML::Node& spec, const std::string& key) {
-  const YAML::Node box = spec[key];
-  if (!box || box.IsNull()) return std::nullopt;
+amytiss::Box stored_box(const YAML::Node& box, const std::string& key) {
   try {
     return amytiss::Box{box["lb"].as<std::vector<double>>(), box["ub"].as<std::vector<double>>()};
   } catch (const YAML::Exception& error) {
-    throw amytiss::ConfigError("spec." + key, std::string("the stored box is not {lb: [..], ub: [..]}: ") + error.what());
+    throw amytiss::ConfigError(key, std::string("the stored box is not {lb: [..], ub: [..]}: ") + error.what());
   }
+}
+
+// One box {lb, ub} or a list of boxes, as the canonical text writes a set.
+std::optional<amytiss::Region> stored_region(const YAML::Node& spec, const std::string& key) {
+  const YAML::Node region = spec[key];
+  if (!region || region.IsNull()) return std::nullopt;
+  if (!region.IsSequence()) return amytiss::Region(stored_box(region, "spec." + key));
+  std::vector<amytiss::Box> boxes;
+  for (std::size_t i = 0; i < region.size(); ++i)
+    boxes.push_back(stored_box(region[i], "spec." + key + "[" + std::to_string(i) + "]"));
+  return amytiss::Region(std::move(boxes));
 }
 
 }  // namespace
@@ -195,9 +204,9 @@ MarkedSets marked_sets_from_yaml(const std::string& config_yaml) {
   if (root["name"]) sets.config_name = root["name"].as<std::string>();
   const YAML::Node spec = root["spec"];
   if (!spec) return sets;
-  sets.safe = stored_box(spec, "safe");
-  sets.target = stored_box(spec, "target");
-  sets.avoid = stored_box(spec, "avoid");
+  sets.safe = stored_region(spec, "safe");
+  sets.target = stored_region(spec, "target");
+  sets.avoid = stored_region(spec, "avoid");
   return sets;
 }
 
@@ -211,12 +220,18 @@ visualization_msgs::MarkerArray make_set_markers(const amytiss::Grid& states, co
     covered_ub[i] += 0.5 * states.eta()[i];
   }
   markers.markers.push_back(outline(project(covered_lb, covered_ub), frame_id, "grid_bounds", 0.2f, 0.2f, 0.2f));
-  if (sets.target)
-    markers.markers.push_back(filled_box(project(sets.target->lb, sets.target->ub), frame_id, "target", 0.1f, 0.8f, 0.1f));
-  if (sets.avoid)
-    markers.markers.push_back(filled_box(project(sets.avoid->lb, sets.avoid->ub), frame_id, "avoid", 0.9f, 0.1f, 0.1f));
-  if (sets.safe)
-    markers.markers.push_back(outline(project(sets.safe->lb, sets.safe->ub), frame_id, "safe", 0.1f, 0.3f, 0.9f));
+  // One marker per box of a set: the set's namespace, the box's index as id.
+  auto add_boxes = [&](const std::optional<amytiss::Region>& set, auto make) {
+    if (!set) return;
+    for (std::size_t i = 0; i < set->boxes.size(); ++i) {
+      visualization_msgs::Marker marker = make(project(set->boxes[i].lb, set->boxes[i].ub));
+      marker.id = static_cast<int>(i);
+      markers.markers.push_back(marker);
+    }
+  };
+  add_boxes(sets.target, [&](const PlaneBox& box) { return filled_box(box, frame_id, "target", 0.1f, 0.8f, 0.1f); });
+  add_boxes(sets.avoid, [&](const PlaneBox& box) { return filled_box(box, frame_id, "avoid", 0.9f, 0.1f, 0.1f); });
+  add_boxes(sets.safe, [&](const PlaneBox& box) { return outline(box, frame_id, "safe", 0.1f, 0.3f, 0.9f); });
   return markers;
 }
 

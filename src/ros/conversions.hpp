@@ -49,18 +49,19 @@ std::string describe_progress(const amytiss::Progress& progress);
 /// in the specification), in state units.
 struct MarkedSets {
   std::string config_name;
-  std::optional<amytiss::Box> safe, target, avoid;
+  std::optional<amytiss::Region> safe, target, avoid;
 };
 
-/// Reads the name and the spec's safe, target and avoid boxes from a policy file's stored
-/// configuration (canonical YAML, see docs/policy_file.md) without parsing and validating the rest:
-/// the file's checksums vouch for it. Throws amytiss::ConfigError naming the key when a box is
-/// not {lb: [...], ub: [...]}.
+/// Reads the name and the spec's safe, target and avoid sets (one box or a list of boxes each) from
+/// a policy file's stored configuration (canonical YAML, see docs/policy_file.md) without parsing
+/// and validating the rest: the file's checksums vouch for it. Throws amytiss::ConfigError naming
+/// the key (spec.avoid[1]) when a box is not {lb: [...], ub: [...]}.
 MarkedSets marked_sets_from_yaml(const std::string& config_yaml);
 
 /// Latched RViz markers over the x0/x1 projection (x1 = 0 for a one-dimensional state):
-/// the covered set's outline (grid bounds: outermost cells' edges of `states`), and boxes for the
-/// target (green), avoid (red) and safe (blue outline) sets. Units: state units, in `frame_id`.
+/// the covered set's outline (grid bounds: outermost cells' edges of `states`), and one box for
+/// every box of the target (green), avoid (red) and safe (blue outline) sets, in the namespace of
+/// its set with the box's index as id. Units: state units, in `frame_id`.
 visualization_msgs::MarkerArray make_set_markers(const amytiss::Grid& states, const MarkedSets& sets,
                                                  const std::string& frame_id);
 

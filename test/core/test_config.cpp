@@ -447,6 +447,90 @@ TEST(Config, CanonicalYamlRoundTrips) {
   EXPECT_EQ(config_from_yaml(YAML::Load(to_yaml(config))).name, config.name);
 }
 
+TEST(Config, SetsAreABoxOrAListOfBoxes) {
+  YAML::Node root = base();
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, 5], ub: [-5, 7]}],"
+      " avoid: [{lb: [-2, -2], ub: [2, 2]}, {lb: [-9, -9], ub: [-8, -8]}, {lb: [8, -9], ub: [9, -8]}]}");
+  const Config config = config_from_yaml(root);
+  ASSERT_EQ(config.spec.target->boxes.size(), 2u);
+  ASSERT_EQ(config.spec.avoid->boxes.size(), 3u);
+  EXPECT_EQ(config.spec.target->boxes[1].lb, (std::vector<double>{-7, 5}));
+  EXPECT_EQ(config.spec.avoid->boxes[2].ub, (std::vector<double>{9, -8}));
+  // The canonical text keeps every box and reads back to the same configuration.
+  const std::string text = to_yaml(config);
+  EXPECT_NE(text.find("  target: [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, 5], ub: [-5, 7]}]\n"), std::string::npos) << text;
+  const Config again = config_from_yaml(YAML::Load(text));
+  EXPECT_EQ(to_yaml(again), text);
+  EXPECT_EQ(config_hash(again), config_hash(config));
+  // Another box changes the hash; a list of one box is that box.
+  root["spec"]["target"] = YAML::Load("[{lb: [5, 5], ub: [7, 7]}]");
+  const Config one_listed = config_from_yaml(root);
+  EXPECT_NE(config_hash(one_listed), config_hash(config));
+  root["spec"]["target"] = YAML::Load("{lb: [5, 5], ub: [7, 7]}");
+  EXPECT_EQ(config_hash(config_from_yaml(root)), config_hash(one_listed));
+
+  root = base();
+  root["spec"]["safe"] = YAML::Load("[{lb: [-10, -10], ub: [0, 10]}, {lb: [2, -10], ub: [10, 10]}]");
+  EXPECT_EQ(config_from_yaml(root).spec.safe->boxes.size(), 2u);
+}
+
+TEST(Config, SetErrorsNameTheBox) {
+  YAML::Node root = base();
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: {lb: [5, 5], ub: [7, 7]},"
+      " avoid: [{lb: [-2, -2], ub: [2, 2]}, {lb: [-9, -9], ub: [-8, -8]}, {lb: [8, -9], ub: [9]}]}");
+  expect_error(root, "spec.avoid[2].ub", "got 1 values, expected 2 values");
+  root["spec"]["avoid"][2] = YAML::Load("{lb: [8, -9], ub: [9, -10]}");
+  expect_error(root, "spec.avoid[2].ub[1]", "expected a number >= spec.avoid[2].lb[1] = -9");
+  root["spec"]["avoid"][2] = YAML::Load("{lb: [8, -9]}");
+  expect_error(root, "spec.avoid[2].ub", "missing");
+  root["spec"]["avoid"][2] = YAML::Load("{lb: [8, -9], ub: [9, -8], eta: [1, 1]}");
+  expect_error(root, "spec.avoid[2].eta", "unknown key");
+  root["spec"]["avoid"][2] = YAML::Load("{lb: [20, -9], ub: [30, -8]}");
+  expect_error(root, "spec.avoid[2]", "contains no representative point");
+  root["spec"]["avoid"] = YAML::Load("[]");
+  expect_error(root, "spec.avoid", "got [], expected a box or a non-empty list of boxes");
+  root["spec"]["avoid"] = YAML::Load("[1, 2]");
+  expect_error(root, "spec.avoid[0]", "expected a map");
+  root["spec"]["avoid"] = "everywhere";
+  expect_error(root, "spec.avoid", "expected a box {lb, ub} or a list of boxes");
+
+  root = base();
+  root["spec"]["safe"] = YAML::Load("[{lb: [-10, -10], ub: [0, 10]}, {lb: [-30, -30], ub: [-20, -20]}]");
+  expect_error(root, "spec.safe[1]", "contains no representative point");
+  root = base();
+  root["spec"] =
+      YAML::Load("{type: reachability, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [5], ub: [7, 7]}]}");
+  expect_error(root, "spec.target[1].lb", "got 1 values, expected 2 values");
+}
+
+TEST(Config, EveryTargetAndAvoidBoxPairMustShareNoGridPoint) {
+  // Avoid box 1 shares [7, 5] with target box 0 (the pair of the single-box rule); the others are apart.
+  YAML::Node root = base();
+  root["spec"] = YAML::Load(
+      "{type: reach_avoid, horizon: 4, target: [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, -7], ub: [-5, -5]}],"
+      " avoid: [{lb: [0, 0], ub: [1, 1]}, {lb: [6.6, 4], ub: [8, 5.2]}]}");
+  expect_error(root, "spec.avoid[1]",
+               "and the target box spec.target[0] [5, 5] .. [7, 7] share grid points, for example [7, 5]");
+  // A single avoid box against the second of two targets.
+  root["spec"]["avoid"] = YAML::Load("{lb: [-5, -5], ub: [-4, -4]}");
+  expect_error(root, "spec.avoid", "the avoid box [-5, -5] .. [-4, -4] and the target box spec.target[1] [-7, -7]");
+  root["spec"]["avoid"] =
+      YAML::Load("[{lb: [0, 0], ub: [1, 1]}, {lb: [7.1, 4], ub: [8, 5.2]}, {lb: [-4.9, -5], ub: [-4, -4]}]");
+  EXPECT_NO_THROW(config_from_yaml(root));
+}
+
+// Files written before sets could be unions carry the hash of their configuration: a single box
+// must keep its text (and so the hash) exactly.
+TEST(Config, SingleBoxSetsKeepTheirTextAndHash) {
+  const Config config = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/robot_reach_avoid.yaml");
+  const std::string text = to_yaml(config);
+  EXPECT_NE(text.find("\n  target: {lb: [5, 5], ub: [7, 7]}\n  avoid: {lb: [-2, -2], ub: [2, 2]}\n"),
+            std::string::npos) << text;
+  EXPECT_EQ(config_hash(config), "de639acadc77740b");  // the hash this configuration has always had
+}
+
 TEST(Config, HashIsStableAndSensitive) {
   const Config config = config_from_yaml(base());
   const std::string hash = config_hash(config);

@@ -119,7 +119,8 @@ TEST(ConfigGate, StoredConfigurationIsReadWithoutTheChecks) {
   EXPECT_EQ(config_hash(stored), config_hash(config));
   EXPECT_EQ(stored.name, "tiny");
   ASSERT_TRUE(stored.spec.target.has_value());
-  EXPECT_EQ(stored.spec.target->lb, (std::vector<double>{3, 0}));
+  ASSERT_EQ(stored.spec.target->boxes.size(), 1u);
+  EXPECT_EQ(stored.spec.target->boxes[0].lb, (std::vector<double>{3, 0}));
 
   Config odd = config;
   odd.compute.memory_fraction = 2;

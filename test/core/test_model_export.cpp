@@ -225,6 +225,18 @@ TEST(ModelExport, ExponentialNoise) {
       "exponential");
 }
 
+TEST(ModelExport, UnionsOfBoxesLabelEveryBoxsCells) {
+  expect_export_matches_engine(
+      "name: export_unions\n"
+      "states: {lb: [-2, -2], ub: [2, 2], eta: [0.5, 0.5]}\n"
+      "inputs: {lb: [-1, -1], ub: [1, 1], eta: [1, 1]}\n"
+      "dynamics: [\"x0 + 0.5*u0\", \"x1 + 0.5*u1\"]\n"
+      "noise: {covariance: [0.04, 0.09], truncation: cutting_probability, cutting_probability: 1.0e-2}\n"
+      "spec: {type: reach_avoid, horizon: 4, target: [{lb: [1, 1], ub: [2, 2]}, {lb: [-2, 1.5], ub: [-1.5, 2]}],\n"
+      "       avoid: [{lb: [-0.5, -0.5], ub: [0.5, 0.5]}, {lb: [1, -2], ub: [2, -1.5]}, {lb: [-2, -2], ub: [-2, -1]}]}\n",
+      "unions");
+}
+
 TEST(ModelExport, RefusesModelsAboveTheLimit) {
   const Abstraction a = Abstraction::from_config(config_from_yaml(YAML::Load(kOneDimensionalYaml)));
   const fs::path folder = scratch("limit");

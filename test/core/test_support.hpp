@@ -101,7 +101,7 @@ inline NoiseConfig uniform_noise(std::vector<double> half_width, Truncation trun
   return noise;
 }
 
-inline SpecConfig safety_spec(unsigned horizon, std::optional<Box> safe = std::nullopt) {
+inline SpecConfig safety_spec(unsigned horizon, std::optional<Region> safe = std::nullopt) {
   SpecConfig spec;
   spec.type = SpecType::Safety;
   spec.horizon = horizon;
@@ -109,7 +109,7 @@ inline SpecConfig safety_spec(unsigned horizon, std::optional<Box> safe = std::n
   return spec;
 }
 
-inline SpecConfig reach_avoid_spec(unsigned horizon, Box target, std::optional<Box> avoid = std::nullopt) {
+inline SpecConfig reach_avoid_spec(unsigned horizon, Region target, std::optional<Region> avoid = std::nullopt) {
   SpecConfig spec;
   spec.type = avoid ? SpecType::ReachAvoid : SpecType::Reachability;
   spec.horizon = horizon;

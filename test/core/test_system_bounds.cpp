@@ -80,10 +80,13 @@ std::vector<std::uint32_t> controller_of(const Policy& policy, std::size_t cells
 // Where the specification stands at a state of the continuous system (closed boxes; avoid wins).
 enum class Place { Undecided, Success, Failure };
 Place place_of(const SpecConfig& spec, const double* x) {
-  auto in = [x](const Box& box) {
-    for (std::size_t d = 0; d < box.lb.size(); ++d)
-      if (x[d] < box.lb[d] || x[d] > box.ub[d]) return false;
-    return true;
+  auto in = [x](const Region& region) {
+    for (const Box& box : region.boxes) {
+      bool inside = true;
+      for (std::size_t d = 0; d < box.lb.size(); ++d) inside = inside && !(x[d] < box.lb[d] || x[d] > box.ub[d]);
+      if (inside) return true;
+    }
+    return false;
   };
   if (spec.type == SpecType::Safety) return spec.safe && !in(*spec.safe) ? Place::Failure : Place::Undecided;
   if (spec.avoid && in(*spec.avoid)) return Place::Failure;
@@ -137,8 +140,9 @@ std::vector<Segment> segments_1d(const Grid& grid, const SpecConfig& spec) {
   const double last = cuts.back();
   for (const auto* set : {&spec.safe, &spec.target, &spec.avoid})
     if (*set)
-      for (double v : {(*set)->lb[0], (*set)->ub[0]})
-        if (v > first && v < last) cuts.push_back(v);
+      for (const Box& box : (*set)->boxes)
+        for (double v : {box.lb[0], box.ub[0]})
+          if (v > first && v < last) cuts.push_back(v);
   std::sort(cuts.begin(), cuts.end());
   cuts.erase(std::unique(cuts.begin(), cuts.end(), [&](double a, double b) { return b - a < 1e-9 * eta; }),
              cuts.end());

@@ -89,6 +89,28 @@ TEST(ConfigFromParams, DeviceOverrideReplacesComputeDeviceButNotTheHash) {
   EXPECT_THROW(amytiss_ros::config_from_params(tree, "quantum"), amytiss::ConfigError);
 }
 
+TEST(ConfigFromParams, ASetGivenAsAListOfBoxesIsAUnion) {
+  XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
+  XmlRpc::XmlRpcValue avoid;
+  avoid.setSize(2);
+  avoid[0]["lb"] = int_list({-1, -1});
+  avoid[0]["ub"] = int_list({1, 1});
+  avoid[1]["lb"] = list({-4.5, 2});
+  avoid[1]["ub"] = list({-3, 3.5});
+  tree["spec"]["avoid"] = avoid;
+  const amytiss::Config config = amytiss_ros::config_from_params(tree);
+  ASSERT_EQ(config.spec.avoid->boxes.size(), 2u);
+  EXPECT_EQ(config.spec.avoid->boxes[1].ub, (std::vector<double>{-3, 3.5}));
+  avoid[1]["ub"] = list({-3});
+  tree["spec"]["avoid"] = avoid;
+  try {
+    amytiss_ros::config_from_params(tree);
+    ADD_FAILURE() << "a box with one upper bound for two states was accepted";
+  } catch (const amytiss::ConfigError& error) {
+    EXPECT_EQ(error.key(), "spec.avoid[1].ub") << error.what();
+  }
+}
+
 TEST(ConfigFromParams, DoublesKeepFullPrecision) {
   XmlRpc::XmlRpcValue tree = tiny_parameter_tree();
   const double awkward = 0.1 + 0.2;  // 0.30000000000000004
@@ -350,6 +372,34 @@ TEST(Markers, GridBoundsTargetAndAvoid) {
   EXPECT_DOUBLE_EQ(target.scale.y, 1.5);
   EXPECT_EQ(markers.markers[2].ns, "avoid");
   EXPECT_EQ(markers.markers[2].header.frame_id, "map");
+}
+
+TEST(Markers, EveryBoxOfAUnionIsAMarkerOfItsSet) {
+  const std::string yaml =
+      "name: unions\nstates: {lb: [-5, -5], ub: [5, 5], eta: [0.5, 0.5]}\ndynamics: [\"x0\", \"x1\"]\n"
+      "noise: {covariance: [0.05, 0.05]}\n"
+      "spec: {type: reach_avoid, horizon: 2, target: [{lb: [3, 3], ub: [4.5, 4.5]}, {lb: [-4.5, 3], ub: [-3, 4.5]}],\n"
+      "       avoid: [{lb: [-1, -1], ub: [1, 1]}, {lb: [2, -4], ub: [3, -3]}, {lb: [-4, -4], ub: [-3, -2]}]}\n";
+  const amytiss::Config config = amytiss::config_from_yaml(YAML::Load(yaml));
+  const amytiss_ros::MarkedSets sets = amytiss_ros::marked_sets_from_yaml(amytiss::to_yaml(config));
+  ASSERT_TRUE(sets.target && sets.avoid);
+  const visualization_msgs::MarkerArray markers =
+      amytiss_ros::make_set_markers(amytiss::Grid(config.states), sets, "map");
+  ASSERT_EQ(markers.markers.size(), 1u + 2u + 3u);
+  EXPECT_EQ(markers.markers[2].ns, "target");
+  EXPECT_EQ(markers.markers[2].id, 1);
+  EXPECT_DOUBLE_EQ(markers.markers[2].pose.position.x, -3.75);
+  EXPECT_EQ(markers.markers[5].ns, "avoid");
+  EXPECT_EQ(markers.markers[5].id, 2);
+  EXPECT_DOUBLE_EQ(markers.markers[5].pose.position.y, -3.0);
+  EXPECT_DOUBLE_EQ(markers.markers[5].scale.x, 1.0);
+  // A stored box that is not {lb, ub} is named with its index.
+  try {
+    amytiss_ros::marked_sets_from_yaml("name: x\nspec: {avoid: [{lb: [0], ub: [1]}, {lb: [0]}]}\n");
+    ADD_FAILURE() << "a stored box without ub was read";
+  } catch (const amytiss::ConfigError& error) {
+    EXPECT_EQ(error.key(), "spec.avoid[1]") << error.what();
+  }
 }
 
 TEST(Convergence, APolicyWhoseGapDidNotCloseSaysSoWithTheGap) {

@@ -27,6 +27,14 @@ std::string grid_yaml(const GridSpec& grid) {
 
 std::string box_yaml(const Box& box) { return "{lb: " + format_list(box.lb) + ", ub: " + format_list(box.ub) + "}"; }
 
+// One box prints as before unions existed, so that the texts and hashes of those configurations stay.
+std::string region_yaml(const Region& region) {
+  if (region.boxes.size() == 1) return box_yaml(region.boxes.front());
+  std::string text = "[";
+  for (std::size_t i = 0; i < region.boxes.size(); ++i) text += (i ? ", " : "") + box_yaml(region.boxes[i]);
+  return text + "]";
+}
+
 std::string canonical_yaml(const Config& config, bool with_compute) {
   std::string text;
   text += "name: " + quoted(config.name) + "\n";
@@ -76,9 +84,9 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   } else {
     text += "  horizon: " + std::to_string(config.spec.horizon) + "\n";
   }
-  if (config.spec.safe) text += "  safe: " + box_yaml(*config.spec.safe) + "\n";
-  if (config.spec.target) text += "  target: " + box_yaml(*config.spec.target) + "\n";
-  if (config.spec.avoid) text += "  avoid: " + box_yaml(*config.spec.avoid) + "\n";
+  if (config.spec.safe) text += "  safe: " + region_yaml(*config.spec.safe) + "\n";
+  if (config.spec.target) text += "  target: " + region_yaml(*config.spec.target) + "\n";
+  if (config.spec.avoid) text += "  avoid: " + region_yaml(*config.spec.avoid) + "\n";
   // Left out when it is the default, so configurations without the key keep their text and hash.
   if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
   if (with_compute) {

@@ -55,8 +55,16 @@ double check_grid(const GridSpec& grid, const std::string& key, const std::strin
   return points;
 }
 
-// A cell in both boxes would silently become avoid (avoid wins in the roles): refuse it.
-void check_target_avoid_disjoint(const Box& target, const Box& avoid, const GridSpec& states) {
+// The key of box `index` of a region: the region's own key for a single box (as before unions
+// existed), else key[index].
+std::string box_key(const std::string& key, const Region& region, std::size_t index) {
+  return region.boxes.size() == 1 ? key : indexed(key, index);
+}
+
+// A cell in both sets would silently become avoid (avoid wins in the roles): refuse every pair of
+// a target box and an avoid box with a common grid point.
+void check_boxes_disjoint(const Box& target, const std::string& target_key, const Box& avoid,
+                          const std::string& avoid_key, const GridSpec& states) {
   std::vector<double> shared;
   for (std::size_t i = 0; i < states.lb.size(); ++i) {
     const IndexRange in_target = box_index_range(states, i, target.lb[i], target.ub[i]);
@@ -65,15 +73,27 @@ void check_target_avoid_disjoint(const Box& target, const Box& avoid, const Grid
     if (first > std::min(in_target.last, in_avoid.last)) return;
     shared.push_back(states.lb[i] + double(first) * states.eta[i]);
   }
-  throw ConfigError("spec.avoid", "the avoid box " + format_list(avoid.lb) + " .. " + format_list(avoid.ub) +
-                                      " and the target box " + format_list(target.lb) + " .. " +
-                                      format_list(target.ub) + " share grid points, for example " +
-                                      format_list(shared) +
-                                      "; expected boxes without a common grid point (shrink one of them)");
+  auto named = [](const std::string& key, const std::string& plain) {
+    return key == plain ? std::string() : " " + key;
+  };
+  throw ConfigError(avoid_key, "the avoid box" + named(avoid_key, "spec.avoid") + " " + format_list(avoid.lb) +
+                                   " .. " + format_list(avoid.ub) + " and the target box" +
+                                   named(target_key, "spec.target") + " " + format_list(target.lb) + " .. " +
+                                   format_list(target.ub) + " share grid points, for example " +
+                                   format_list(shared) +
+                                   "; expected boxes without a common grid point (shrink one of them)");
+}
+
+void check_target_avoid_disjoint(const Region& target, const Region& avoid, const GridSpec& states) {
+  for (std::size_t j = 0; j < avoid.boxes.size(); ++j)
+    for (std::size_t i = 0; i < target.boxes.size(); ++i)
+      check_boxes_disjoint(target.boxes[i], box_key("spec.target", target, i), avoid.boxes[j],
+                           box_key("spec.avoid", avoid, j), states);
 }
 
 void check_box(const Box& box, const std::string& key, const GridSpec& states) {
-  const std::string name = key.substr(key.rfind('.') + 1);
+  std::string name = key.substr(key.rfind('.') + 1);
+  name = name.substr(0, name.find('['));  // "avoid" of "spec.avoid[2]"
   const std::string example = name + ": {lb: [5, 5], ub: [7, 7]}";
   const std::size_t n = states.lb.size();
   if (box.lb.size() != n)
@@ -98,6 +118,14 @@ void check_box(const Box& box, const std::string& key, const GridSpec& states) {
                                  format_number(states.lb[i] + (count - 1) * eta) +
                                  "); widen the box or refine states.eta (example: " + example + ")");
   }
+}
+
+// Each box as a single box is checked, under its own key (spec.avoid[2].lb).
+void check_region(const Region& region, const std::string& key, const GridSpec& states) {
+  if (region.boxes.empty())
+    fail(key, "[]", "a box or a non-empty list of boxes",
+         key.substr(key.rfind('.') + 1) + ": [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, 5], ub: [-5, 7]}]");
+  for (std::size_t i = 0; i < region.boxes.size(); ++i) check_box(region.boxes[i], box_key(key, region, i), states);
 }
 
 bool is_identifier(const std::string& name) {
@@ -200,19 +228,20 @@ void check_spec(const SpecConfig& spec, const GridSpec& states) {
     case SpecType::Safety:
       if (spec.target) throw ConfigError("spec.target", "given for spec.type safety; safety uses `safe` (or the whole grid)");
       if (spec.avoid) throw ConfigError("spec.avoid", "given for spec.type safety; use reach_avoid, or `safe` for the set to stay in");
-      if (spec.safe) check_box(*spec.safe, "spec.safe", states);
+      if (spec.safe) check_region(*spec.safe, "spec.safe", states);
       break;
     case SpecType::Reachability:
     case SpecType::ReachAvoid:
       if (spec.safe) throw ConfigError("spec.safe", "given for spec.type " + to_string(spec.type) + "; `safe` is for safety only");
       if (!spec.target)
-        throw ConfigError("spec.target", "missing, expected the target box for " + to_string(spec.type) +
+        throw ConfigError("spec.target", "missing, expected the target box (or a list of boxes) for " +
+                                             to_string(spec.type) +
                                              " (example: target: {lb: [5, 5], ub: [7, 7]})");
-      check_box(*spec.target, "spec.target", states);
+      check_region(*spec.target, "spec.target", states);
       if (spec.avoid) {
         if (spec.type == SpecType::Reachability)
           throw ConfigError("spec.avoid", "given for spec.type reachability; use reach_avoid to avoid a set");
-        check_box(*spec.avoid, "spec.avoid", states);
+        check_region(*spec.avoid, "spec.avoid", states);
         check_target_avoid_disjoint(*spec.target, *spec.avoid, states);
       }
       break;

@@ -112,6 +112,16 @@ Box read_box(const YAML::Node& node, const std::string& key, const std::string& 
   return box;
 }
 
+// One box {lb, ub}, or a list of boxes whose keys carry the index (spec.avoid[2].lb).
+Region read_region(const YAML::Node& node, const std::string& key, const std::string& example) {
+  if (node.IsMap()) return Region(read_box(node, key, example));
+  if (!node.IsSequence())
+    fail(key, node_text(node), "a box {lb, ub} or a list of boxes",
+         key.substr(key.rfind('.') + 1) + ": " + example + " or [" + example + ", ...]");
+  std::vector<Box> boxes;
+  for (std::size_t i = 0; i < node.size(); ++i) boxes.push_back(read_box(node[i], indexed(key, i), example));
+  return Region(std::move(boxes));
+}
 
 std::map<std::string, double> read_constants(const YAML::Node& constants) {
   const char* const example = "constants: {tau: 10.0}";
@@ -183,9 +193,9 @@ SpecConfig read_spec(const YAML::Node& spec) {
   else
     config.horizon = read_count(horizon, "spec.horizon", "horizon: 16 (or horizon: infinite)");
   if (present(spec["tolerance"])) config.tolerance = read_number(spec["tolerance"], "spec.tolerance", "tolerance: 1.0e-6");
-  if (present(spec["safe"])) config.safe = read_box(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
-  if (present(spec["target"])) config.target = read_box(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
-  if (present(spec["avoid"])) config.avoid = read_box(spec["avoid"], "spec.avoid", "{lb: [-2, -2], ub: [2, 2]}");
+  if (present(spec["safe"])) config.safe = read_region(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
+  if (present(spec["target"])) config.target = read_region(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
+  if (present(spec["avoid"])) config.avoid = read_region(spec["avoid"], "spec.avoid", "{lb: [-2, -2], ub: [2, 2]}");
   return config;
 }
 

@@ -52,6 +52,8 @@ RobustValues robust_values(const RobustProblem& problem, AmbiguitySet set);
 /// count. Lower: target only when the cell lies inside the target, avoid (safety: unsafe) as soon
 /// as it meets the avoid set (leaves the safe set). Upper: target as soon as it meets the target,
 /// avoid only inside the avoid set (unsafe only when it misses the safe set). Avoid wins.
+/// Sets that are unions of boxes: "meets" is meeting one of the boxes, "inside" is lying inside
+/// their union (exactly: a cell covered by several boxes together is inside).
 constexpr double kFaceTolerance = 1e-9;
 std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& spec, Bound bound);
 

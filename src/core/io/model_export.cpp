@@ -319,10 +319,11 @@ std::string readme_text(const Abstraction& a, const ExportLayout& layout, Export
       a.unbounded ? std::string() : "<=" + std::to_string(layout.adversary ? 2 * horizon : horizon);
   const std::string which = a.unbounded ? "unbounded value" : "bounded-horizon value V_0";
   if (a.spec == SpecType::Safety)
-    s << "`unsafe`: the cells outside the safe set. The " << which << " of amytiss is\n\n"
+    s << "`unsafe`: the cells whose point lies in no box of the safe set. The " << which << " of amytiss is\n\n"
       << "    Pmax=? [ G" << bound << " !(\"unsafe\" | \"sink\") ]\n\n";
   else
-    s << "`target`: the target cells; `avoid`: the cells to avoid. The " << which << " of amytiss is\n\n"
+    s << "`target`: the cells whose point lies in a target box; `avoid`: those in an avoid box. The " << which
+      << " of amytiss is\n\n"
       << "    Pmax=? [ !(\"avoid\" | \"sink\") U" << bound << " \"target\" ]\n\n";
   s << "from each cell";
   if (!a.unbounded) s << " (horizon T = " << horizon << ", " << steps << " model steps)";

@@ -13,8 +13,10 @@ void require(bool invariant, const std::string& what) {
   if (!invariant) throw std::logic_error("Abstraction: expected a validated configuration: " + what);
 }
 
-void require_box(const Box& box, std::size_t dims) {
-  require(box.lb.size() == dims && box.ub.size() == dims, "boxes with one bound per state dimension");
+void require_region(const Region& region, std::size_t dims) {
+  require(!region.boxes.empty(), "sets of at least one box");
+  for (const Box& box : region.boxes)
+    require(box.lb.size() == dims && box.ub.size() == dims, "boxes with one bound per state dimension");
 }
 
 }  // namespace
@@ -25,21 +27,21 @@ std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
   switch (spec.type) {
     case SpecType::Safety:
       if (spec.safe) {
-        require_box(*spec.safe, dims);
+        require_region(*spec.safe, dims);
         for (std::size_t cell = 0; cell < roles.size(); ++cell)
-          if (!states.point_in_box(cell, *spec.safe)) roles[cell] = CellRole::FixedZero;
+          if (!states.point_in_region(cell, *spec.safe)) roles[cell] = CellRole::FixedZero;
       }
       break;
     case SpecType::Reachability:
     case SpecType::ReachAvoid: {
-      require(spec.target.has_value(), "a target box for reachability and reach_avoid");
-      require_box(*spec.target, dims);
+      require(spec.target.has_value(), "a target set for reachability and reach_avoid");
+      require_region(*spec.target, dims);
       const bool with_avoid = spec.type == SpecType::ReachAvoid && spec.avoid.has_value();
-      if (with_avoid) require_box(*spec.avoid, dims);
+      if (with_avoid) require_region(*spec.avoid, dims);
       for (std::size_t cell = 0; cell < roles.size(); ++cell) {
-        if (with_avoid && states.point_in_box(cell, *spec.avoid))
+        if (with_avoid && states.point_in_region(cell, *spec.avoid))
           roles[cell] = CellRole::FixedZero;
-        else if (states.point_in_box(cell, *spec.target))
+        else if (states.point_in_region(cell, *spec.target))
           roles[cell] = CellRole::FixedOne;
       }
       break;

@@ -110,4 +110,10 @@ bool Grid::point_in_box(std::size_t flat, const Box& box) const {
   return true;
 }
 
+bool Grid::point_in_region(std::size_t flat, const Region& region) const {
+  for (const Box& box : region.boxes)
+    if (point_in_box(flat, box)) return true;
+  return false;
+}
+
 }  // namespace amytiss
