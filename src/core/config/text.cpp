@@ -27,7 +27,7 @@ std::string grid_yaml(const GridSpec& grid) {
 
 std::string box_yaml(const Box& box) { return "{lb: " + format_list(box.lb) + ", ub: " + format_list(box.ub) + "}"; }
 
-std::string canonical_yaml(const Config& config, bool with_compute) {
+std::string canonical_yaml(const Config& config, bool with_unhashed_sections) {
   std::string text;
   text += "name: " + quoted(config.name) + "\n";
   text += "states: " + grid_yaml(config.states) + "\n";
@@ -81,7 +81,8 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   if (config.spec.avoid) text += "  avoid: " + box_yaml(*config.spec.avoid) + "\n";
   // Left out when it is the default, so configurations without the key keep their text and hash.
   if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
-  if (with_compute) {
+  // compute and output change how the result is computed or stored, not the result: no hash.
+  if (with_unhashed_sections) {
     const ComputeConfig& compute = config.compute;
     text += "compute:\n";
     text += "  device: " + to_string(compute.device) + "\n";
@@ -95,6 +96,9 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
       for (std::size_t i = 0; i < compute.devices.size(); ++i) text += (i ? ", " : "") + quoted(compute.devices[i]);
       text += "]\n";
     }
+    // Left out when it is the default, so files of configurations without the key keep their text.
+    if (config.output.values != ValueStorage::Exact)
+      text += "output: {values: " + to_string(config.output.values) + "}\n";
   }
   return text;
 }
