@@ -73,8 +73,8 @@ class Hdf5Writer {
   /// reader verifies on every read: Compressed adds HDF5's shuffle and deflate filters (every HDF5
   /// build with zlib reads them: h5py, MATLAB, h5dump).
   enum class Filters { ChecksumOnly, Compressed };
-  /// A dataset of `shape`; non-empty ones are chunked (whole trailing dimensions, at most
-  /// kChunkBytes per chunk, so a time step of a policy array is one chunk or a few).
+  /// A dataset of `shape`; non-empty ones are chunked: whole trailing dimensions, at most
+  /// kChunkBytes per chunk (one or several time steps of a policy array while a step fits).
   void dataset(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type, hid_t memory_type,
                const void* data, Filters filters = Filters::ChecksumOnly) const;
 
