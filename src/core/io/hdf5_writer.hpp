@@ -74,11 +74,14 @@ class Hdf5Writer {
   /// build with zlib reads them: h5py, MATLAB, h5dump).
   enum class Filters { ChecksumOnly, Compressed };
   /// A dataset of `shape`; non-empty ones are chunked: whole trailing dimensions, at most
-  /// kChunkBytes per chunk (one or several time steps of a policy array while a step fits).
+  /// kChunkBytes per chunk.
   void dataset(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type, hid_t memory_type,
                const void* data, Filters filters = Filters::ChecksumOnly) const;
 
-  static constexpr std::uint64_t kChunkBytes = 8u << 20;
+  /// HDF5's default chunk cache size: a reader's chunk buffers are then reused from one chunk to
+  /// the next instead of being mapped afresh (larger chunks made loading bmw_parking's file a
+  /// quarter slower; BENCHMARKS.md, "Policy file sizes").
+  static constexpr std::uint64_t kChunkBytes = 1u << 20;
   /// zlib level of Filters::Compressed: 1 compresses policy arrays almost as well as 4 at a
   /// fraction of the time (BENCHMARKS.md, "Policy file sizes").
   static constexpr unsigned kDeflateLevel = 1;
