@@ -12,8 +12,9 @@
 //   /input_values      float64 (n_inputs, input_dims)      the input grid's points
 //   /roles             uint8   (n0, n1, ...)  0 free, 1 fixed zero (avoid/unsafe), 2 fixed one (target)
 // An unbounded specification's stationary policy (horizon 1) adds the attributes stationary = 1
-// and iterations (interval iterations done), and /upper_values float64 (n0, n1, ...): the upper
-// bound of the optimal value; /values[0] (= /values[1]) holds the certified lower bound.
+// and iterations (interval iterations done), and /upper_values (n0, n1, ...), of the type of
+// /values (float32 rounded up): the upper bound of the optimal value; /values[0] (= /values[1])
+// holds the certified lower bound.
 // Every non-empty array is chunked with HDF5's Fletcher-32 checksum; the large ones are also
 // shuffled and deflated. The file is built in memory,
 // written to "<path>.tmp.<pid>", flushed and renamed, so a reader never sees half a file; a
