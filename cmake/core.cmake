@@ -83,7 +83,7 @@ if(AMYTISS_CORE_TESTS)
       string(REGEX REPLACE "^test_" "" test_name "${test_name}")
       add_executable(amytiss_test_${test_name} ${test_file})
       target_link_libraries(amytiss_test_${test_name} amytiss_core GTest::gtest GTest::gtest_main)
-      target_include_directories(amytiss_test_${test_name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core)
+      target_include_directories(amytiss_test_${test_name} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core ${HDF5_INCLUDE_DIRS})
       target_compile_definitions(amytiss_test_${test_name} PRIVATE
         AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
         AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>"
@@ -91,7 +91,7 @@ if(AMYTISS_CORE_TESTS)
     endforeach()
   endif()
   target_link_libraries(amytiss_core_tests amytiss_core)
-  target_include_directories(amytiss_core_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core)
+  target_include_directories(amytiss_core_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/core ${HDF5_INCLUDE_DIRS})
   target_compile_definitions(amytiss_core_tests PRIVATE
     AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
     AMYTISS_SYNTH_BIN="$<TARGET_FILE:amytiss_synth>"

@@ -4,7 +4,7 @@
 usage: inspect_policy.py POLICY.h5
 
 Prints the root attributes, then one line per dataset: its path, element type and shape, and
-a V_0 summary. Exits 1 when the file is not an amytiss policy. Used by test_cli to show that
+a V_0 summary. Filters follow the shape: shuffle, gzip(level), fletcher32. Exits 1 when the file is not an amytiss policy. Used by test_cli to show that
 Python opens the files the C++ core writes.
 """
 import sys
@@ -35,8 +35,10 @@ def main(argv):
             lambda name, item: datasets.append((name, item)) if isinstance(item, h5py.Dataset) else None)
         for name, dataset in sorted(datasets):
             kind = "string" if h5py.check_string_dtype(dataset.dtype) else str(dataset.dtype)
-            checksum = " fletcher32" if dataset.fletcher32 else ""
-            print(f"dataset /{name} {kind} {tuple(dataset.shape)}{checksum}")
+            filters = " shuffle" if dataset.shuffle else ""
+            filters += f" {dataset.compression}({dataset.compression_opts})" if dataset.compression else ""
+            filters += " fletcher32" if dataset.fletcher32 else ""
+            print(f"dataset /{name} {kind} {tuple(dataset.shape)}{filters}")
 
         values = policy_file["values"][0]
         roles = policy_file["roles"][()]

@@ -145,6 +145,17 @@ struct DeviceSelector {
 /// The selector a compute.devices entry names, or nullopt when the text is not one.
 std::optional<DeviceSelector> parse_device_selector(const std::string& text);
 
+/// How the policy file stores the value arrays (docs/policy_file.md): `exact`, float64 as
+/// computed; `float32_lower`, float32 rounded outward (lower bounds down, upper bounds up: each
+/// stays a bound) at half the size.
+enum class ValueStorage { Exact, Float32Lower };
+
+/// How results are written; like `compute`, not part of the configuration hash (the same policy,
+/// stored differently).
+struct OutputConfig {
+  ValueStorage values = ValueStorage::Exact;
+};
+
 struct Config {
   std::string name;
   GridSpec states;
@@ -160,6 +171,7 @@ struct Config {
   SpecConfig spec;
   Guarantee guarantee = Guarantee::Abstraction;
   ComputeConfig compute;
+  OutputConfig output;
 
   /// The only place that judges user input (docs/configuration.md, "Checks"). Throws
   /// ConfigError for the first problem found: dimensions that disagree,
@@ -205,7 +217,8 @@ Config read_stored_config(const std::string& yaml_text);
 /// Canonical YAML text of the configuration: all keys, fixed order, full precision. Parsing it
 /// again gives an equal Config.
 std::string to_yaml(const Config& config);
-/// Hash of the parts that determine the result (everything but `compute`), as 16 hex digits.
+/// Hash of the parts that determine the result (everything but `compute` and `output`), as 16 hex
+/// digits.
 std::string config_hash(const Config& config);
 
 /// Names used in messages and files: "safety", "reach_avoid", "normal", "auto", ...
@@ -218,5 +231,6 @@ std::string to_string(Distribution);
 std::string to_string(Truncation);
 std::string to_string(IntegrationMethod);
 std::string to_string(Guarantee);
+std::string to_string(ValueStorage);
 
 }  // namespace amytiss

@@ -5,14 +5,18 @@
 //                    content_digest (16 hex digits over all attributes and datasets)
 //   /config            string: canonical YAML of the configuration (to_yaml)
 //   /states/{lb,eta,counts}, /inputs/{lb,eta,counts}   float64 / uint64 vectors
-//   /values            float64 (horizon+1, n0, n1, ...)   V_k(x)
-//   /input_index       uint32  (horizon,   n0, n1, ...)   flat index of u*(x,k) in the input grid
+//   /values            float64 (horizon+1, n0, n1, ...)   V_k(x); float32 rounded down with
+//                      output.values: float32_lower
+//   /input_index       uint8/16/32 (horizon, n0, n1, ...) flat index of u*(x,k) in the input grid,
+//                      the narrowest type for the grid's inputs
 //   /input_values      float64 (n_inputs, input_dims)      the input grid's points
 //   /roles             uint8   (n0, n1, ...)  0 free, 1 fixed zero (avoid/unsafe), 2 fixed one (target)
 // An unbounded specification's stationary policy (horizon 1) adds the attributes stationary = 1
-// and iterations (interval iterations done), and /upper_values float64 (n0, n1, ...): the upper
-// bound of the optimal value; /values[0] (= /values[1]) holds the certified lower bound.
-// Every non-empty array is chunked with HDF5's Fletcher-32 checksum. The file is built in memory,
+// and iterations (interval iterations done), and /upper_values (n0, n1, ...), of the type of
+// /values (float32 rounded up): the upper bound of the optimal value; /values[0] (= /values[1])
+// holds the certified lower bound.
+// Every non-empty array is chunked with HDF5's Fletcher-32 checksum; the large ones are also
+// shuffled and deflated. The file is built in memory,
 // written to "<path>.tmp.<pid>", flushed and renamed, so a reader never sees half a file; a
 // terminating signal during the write removes the temporary file, and every write first removes
 // those of dead processes.

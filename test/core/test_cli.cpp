@@ -250,11 +250,12 @@ TEST_F(CliTest, PythonH5pyOpensTheFileWithTheDocumentedLayout) {
   EXPECT_CONTAINS(result.out, "attribute horizon = 4");
   EXPECT_CONTAINS(result.out, "attribute spec = reach_avoid");
   EXPECT_CONTAINS(result.out, "dataset /config string ()");
-  // Every array carries HDF5's Fletcher-32 checksum, which h5py verifies too.
-  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9) fletcher32");
-  EXPECT_CONTAINS(result.out, "dataset /input_index uint32 (4, 9, 9) fletcher32");
+  // Every array carries HDF5's Fletcher-32 checksum, which h5py verifies too; the large ones are
+  // compressed, and 9 inputs take uint8 indices.
+  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9) shuffle gzip(1) fletcher32");
+  EXPECT_CONTAINS(result.out, "dataset /input_index uint8 (4, 9, 9) shuffle gzip(1) fletcher32");
   EXPECT_CONTAINS(result.out, "dataset /input_values float64 (9, 2) fletcher32");
-  EXPECT_CONTAINS(result.out, "dataset /roles uint8 (9, 9) fletcher32");
+  EXPECT_CONTAINS(result.out, "dataset /roles uint8 (9, 9) shuffle gzip(1) fletcher32");
   for (const char* grid : {"states", "inputs"}) {
     EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/lb float64 (2,)");
     EXPECT_CONTAINS(result.out, std::string("dataset /") + grid + "/eta float64 (2,)");

@@ -392,6 +392,26 @@ TEST(Config, ComputeErrors) {
   EXPECT_EQ(config.compute.device_name, "nvidia");
 }
 
+// output.values changes how the policy file stores the values, not the policy: the hash stays,
+// the stored text (to_yaml) keeps it, and only the two storage names are accepted.
+TEST(Config, OutputValuesIsStoredButNotHashed) {
+  YAML::Node root = base();
+  const Config exact = config_from_yaml(root);
+  EXPECT_EQ(exact.output.values, ValueStorage::Exact);
+  EXPECT_EQ(to_yaml(exact).find("output"), std::string::npos);
+  root["output"] = YAML::Load("{values: float32_lower}");
+  const Config float32 = config_from_yaml(root);
+  EXPECT_EQ(float32.output.values, ValueStorage::Float32Lower);
+  EXPECT_EQ(config_hash(float32), config_hash(exact));
+  EXPECT_EQ(read_stored_config(to_yaml(float32)).output.values, ValueStorage::Float32Lower);
+  root["output"] = YAML::Load("{values: float16}");
+  expect_error(root, "output.values", "'float16'");
+  expect_error(root, "output.values", "expected one of exact, float32_lower");
+  expect_error(root, "output.values", "values: float32_lower");
+  root["output"] = YAML::Load("{value: exact}");
+  expect_error(root, "output.value", "unknown key (valid keys of output: values)");
+}
+
 TEST(Config, ValidateOnAStructBuiltInCode) {
   Config config = config_from_yaml(base());
   config.states.eta[0] = std::nan("");

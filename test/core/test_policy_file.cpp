@@ -13,6 +13,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
+#include "io/hdf5_handle.hpp"
 
 #include "policy_test_data.hpp"
 #include "test_support.hpp"
@@ -292,17 +293,24 @@ std::string file_bytes(const std::string& file_path) {
   return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
 }
 
-template <typename T>
-std::string bytes_of(const std::vector<T>& values, std::size_t count) {
-  return std::string(reinterpret_cast<const char*>(values.data()), count * sizeof(T));
-}
-
-// Where `pattern` first occurs in the file (the start of an array whose first elements it is;
-// the hand-made arrays repeat themselves, so later occurrences lie inside the same array).
+// Where `pattern` first occurs in the file.
 std::size_t offset_of(const std::string& file_path, const std::string& pattern) {
   const std::size_t at = file_bytes(file_path).find(pattern);
   EXPECT_NE(std::string::npos, at) << "pattern not found";
   return at == std::string::npos ? 0 : at;
+}
+
+// Where the first chunk of dataset `name` lies in the file: its offset and its stored (checksummed,
+// possibly compressed) size in bytes.
+std::pair<std::size_t, std::size_t> first_chunk(const std::string& file_path, const std::string& name) {
+  detail::Hdf5Handle file(H5Fopen(file_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  detail::Hdf5Handle dataset(H5Dopen2(file.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+  detail::Hdf5Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  haddr_t address = HADDR_UNDEF;
+  hsize_t size = 0;
+  unsigned filter_mask = 0;
+  EXPECT_GE(H5Dget_chunk_info(dataset.get(), space.get(), 0, nullptr, &filter_mask, &address, &size), 0) << name;
+  return {std::size_t(address), std::size_t(size)};
 }
 
 void overwrite(const std::string& file_path, std::size_t offset, const std::string& bytes) {
@@ -322,8 +330,8 @@ TEST_F(PolicyFileTest, ZeroedValuesAreRefused) {
   const Policy policy = tiny_policy(config);
   write_policy_file(path("p.h5"), policy, config);
   // Zeros are valid probabilities: only the checksum can tell.
-  const std::size_t at = offset_of(path("p.h5"), bytes_of(policy.values, 8));
-  overwrite(path("p.h5"), at, std::string(policy.values.size() * sizeof(double) / 2, '\0'));
+  const auto [at, size] = first_chunk(path("p.h5"), "/values");
+  overwrite(path("p.h5"), at, std::string(size / 2, '\0'));
   const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
   EXPECT_NE(std::string::npos, message.find("'/values' (its checksum does not match")) << message;
 }
@@ -332,8 +340,8 @@ TEST_F(PolicyFileTest, ZeroedInputIndicesAreRefused) {
   const Config config = tiny_config();
   const Policy policy = tiny_policy(config);
   write_policy_file(path("p.h5"), policy, config);
-  const std::size_t at = offset_of(path("p.h5"), bytes_of(policy.input_index, 12));
-  overwrite(path("p.h5"), at, std::string(policy.input_index.size() * sizeof(std::uint32_t), '\0'));
+  const auto [at, size] = first_chunk(path("p.h5"), "/input_index");
+  overwrite(path("p.h5"), at, std::string(size, '\0'));
   const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
   EXPECT_NE(std::string::npos, message.find("'/input_index' (its checksum does not match")) << message;
 }
@@ -341,16 +349,11 @@ TEST_F(PolicyFileTest, ZeroedInputIndicesAreRefused) {
 TEST_F(PolicyFileTest, OneFlippedBitInAnyArrayIsRefused) {
   const Config config = tiny_config();
   const Policy policy = tiny_policy(config);
-  std::vector<std::uint8_t> roles;
-  for (CellRole role : policy.roles) roles.push_back(std::uint8_t(role));
-  const std::vector<std::pair<std::string, std::string>> arrays = {
-      {"/values", bytes_of(policy.values, 8)},
-      {"/input_index", bytes_of(policy.input_index, 12)},
-      {"/roles", bytes_of(roles, roles.size())},
-      {"/states/lb", bytes_of(policy.states.lb(), 2)}};
-  for (const auto& [name, pattern] : arrays) {
+  // Compressed (/values, /input_index, /roles) or not (/states/lb).
+  for (const std::string name : {"/values", "/input_index", "/roles", "/states/lb"}) {
     write_policy_file(path("p.h5"), policy, config);
-    flip_bit(path("p.h5"), offset_of(path("p.h5"), pattern) + pattern.size() / 2);
+    const auto [at, size] = first_chunk(path("p.h5"), name);
+    flip_bit(path("p.h5"), at + size / 2);
     const std::string message = refusal([&] { read_policy_file(path("p.h5")); });
     EXPECT_NE(std::string::npos, message.find("'" + name + "' (its checksum does not match")) << message;
   }

@@ -62,6 +62,12 @@ const std::vector<std::pair<const char*, Guarantee>>& enum_names() {
   return names;
 }
 template <>
+const std::vector<std::pair<const char*, ValueStorage>>& enum_names() {
+  static const std::vector<std::pair<const char*, ValueStorage>> names = {{"exact", ValueStorage::Exact},
+                                                                          {"float32_lower", ValueStorage::Float32Lower}};
+  return names;
+}
+template <>
 const std::vector<std::pair<const char*, Phase>>& enum_names() {
   static const std::vector<std::pair<const char*, Phase>> names = {
       {"setup", Phase::Setup}, {"construction", Phase::Construction}, {"synthesis", Phase::Synthesis}, {"done", Phase::Done}};
@@ -101,6 +107,7 @@ std::string to_string(Distribution value) { return name_of(value); }
 std::string to_string(Truncation value) { return name_of(value); }
 std::string to_string(IntegrationMethod value) { return name_of(value); }
 std::string to_string(Guarantee value) { return name_of(value); }
+std::string to_string(ValueStorage value) { return name_of(value); }
 std::string to_string(Phase value) { return name_of(value); }
 std::string to_string(NoteSeverity value) { return name_of(value); }
 std::string to_string(NoteKind value) { return name_of(value); }

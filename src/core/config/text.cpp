@@ -35,7 +35,29 @@ std::string region_yaml(const Region& region) {
   return text + "]";
 }
 
-std::string canonical_yaml(const Config& config, bool with_compute) {
+// compute and output: how the result is computed and stored.
+std::string unhashed_yaml(const Config& config) {
+  std::string text;
+  const ComputeConfig& compute = config.compute;
+  text += "compute:\n";
+  text += "  device: " + to_string(compute.device) + "\n";
+  text += "  transitions: " + to_string(compute.transitions) + "\n";
+  text += "  sweep: " + to_string(compute.sweep) + "\n";
+  text += "  platform: " + quoted(compute.platform) + "\n";
+  text += "  device_name: " + quoted(compute.device_name) + "\n";
+  text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";
+  if (!compute.devices.empty()) {
+    text += "  devices: [";
+    for (std::size_t i = 0; i < compute.devices.size(); ++i) text += (i ? ", " : "") + quoted(compute.devices[i]);
+    text += "]\n";
+  }
+  // Left out when it is the default, so files of configurations without the key keep their text.
+  if (config.output.values != ValueStorage::Exact)
+    text += "output: {values: " + to_string(config.output.values) + "}\n";
+  return text;
+}
+
+std::string canonical_yaml(const Config& config, bool with_unhashed_sections) {
   std::string text;
   text += "name: " + quoted(config.name) + "\n";
   text += "states: " + grid_yaml(config.states) + "\n";
@@ -89,21 +111,8 @@ std::string canonical_yaml(const Config& config, bool with_compute) {
   if (config.spec.avoid) text += "  avoid: " + region_yaml(*config.spec.avoid) + "\n";
   // Left out when it is the default, so configurations without the key keep their text and hash.
   if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
-  if (with_compute) {
-    const ComputeConfig& compute = config.compute;
-    text += "compute:\n";
-    text += "  device: " + to_string(compute.device) + "\n";
-    text += "  transitions: " + to_string(compute.transitions) + "\n";
-    text += "  sweep: " + to_string(compute.sweep) + "\n";
-    text += "  platform: " + quoted(compute.platform) + "\n";
-    text += "  device_name: " + quoted(compute.device_name) + "\n";
-    text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";
-    if (!compute.devices.empty()) {
-      text += "  devices: [";
-      for (std::size_t i = 0; i < compute.devices.size(); ++i) text += (i ? ", " : "") + quoted(compute.devices[i]);
-      text += "]\n";
-    }
-  }
+  // compute and output change how the result is computed or stored, not the result: no hash.
+  if (with_unhashed_sections) text += unhashed_yaml(config);
   return text;
 }
 

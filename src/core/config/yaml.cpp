@@ -225,6 +225,14 @@ ComputeConfig read_compute(const YAML::Node& compute) {
   return config;
 }
 
+OutputConfig read_output(const YAML::Node& output) {
+  check_keys(output, "output", {"values"}, "output: {values: float32_lower}");
+  OutputConfig config;
+  if (present(output["values"]))
+    config.values = read_enum<ValueStorage>(output["values"], "output.values", "values: float32_lower");
+  return config;
+}
+
 YAML::Node parse_yaml_text(const std::string& text, const std::string& key) {
   try {
     return YAML::Load(text);
@@ -239,7 +247,7 @@ YAML::Node parse_yaml_text(const std::string& text, const std::string& key) {
 Config read_config(const YAML::Node& root) {
   const char* const name_example = "name: robot_reach_avoid";
   check_keys(root, "", {"name", "states", "inputs", "disturbances", "constants", "dynamics", "model", "integrator",
-                        "noise", "spec", "guarantee", "compute"},
+                        "noise", "spec", "guarantee", "compute", "output"},
              name_example);
   Config config;
   config.name = read_string(required(root, "name", "name", name_example), "name", name_example);
@@ -260,6 +268,7 @@ Config read_config(const YAML::Node& root) {
   if (present(root["guarantee"]))
     config.guarantee = read_enum<Guarantee>(root["guarantee"], "guarantee", "guarantee: system");
   if (present(root["compute"])) config.compute = read_compute(root["compute"]);
+  if (present(root["output"])) config.output = read_output(root["output"]);
   return config;
 }
 

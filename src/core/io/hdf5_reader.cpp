@@ -128,6 +128,15 @@ Hdf5Handle Hdf5Reader::open_numeric(const std::string& name, H5T_class_t expecte
   return dataset;
 }
 
+Hdf5Reader::ElementType Hdf5Reader::element_type(const std::string& name) const {
+  Hdf5Handle dataset = open_dataset(name);
+  Hdf5Handle type(H5Dget_type(dataset.get()), H5Tclose);
+  if (!type.valid()) corrupt("dataset '" + name + "'");
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  const bool is_signed = type_class == H5T_INTEGER && H5Tget_sign(type.get()) != H5T_SGN_NONE;
+  return {type_class, H5Tget_size(type.get()), is_signed};
+}
+
 void Hdf5Reader::read_numeric(hid_t dataset, const std::string& name, hid_t memory_type, void* data,
                               std::size_t elements) const {
   // HDF5 verifies the Fletcher-32 checksum of each chunk here.

@@ -47,6 +47,14 @@ class Hdf5Reader {
     read_numeric(dataset.get(), name, memory_type, data.data(), elements);
     return data;
   }
+  /// The stored element type of a numeric dataset: its class, size in bytes and, for integers,
+  /// whether it is signed.
+  struct ElementType {
+    H5T_class_t type_class;
+    std::size_t bytes;
+    bool is_signed;
+  };
+  ElementType element_type(const std::string& name) const;
   /// A numeric vector of any length.
   template <typename T>
   std::vector<T> vector_dataset(const std::string& name, H5T_class_t expected_class, hid_t memory_type) const {

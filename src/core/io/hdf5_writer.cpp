@@ -140,7 +140,7 @@ void Hdf5Writer::group(const std::string& name) const {
 }
 
 void Hdf5Writer::dataset(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type,
-                         hid_t memory_type, const void* data) const {
+                         hid_t memory_type, const void* data, Filters filters) const {
   Hdf5Handle space =
       checked(H5Screate_simple(int(shape.size()), shape.empty() ? nullptr : shape.data(), nullptr), H5Sclose, name);
   hsize_t elements = 1;
@@ -149,6 +149,14 @@ void Hdf5Writer::dataset(const std::string& name, const std::vector<hsize_t>& sh
   if (elements > 0) {
     const std::vector<hsize_t> chunk = chunk_shape(shape, H5Tget_size(file_type));
     check(H5Pset_chunk(properties.get(), int(chunk.size()), chunk.data()), name);
+    if (filters == Filters::Compressed) {
+      if (H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0)
+        throw PolicyFileError("cannot write " + name + ": this HDF5 library has no deflate (zlib) filter");
+      // Shuffle groups the bytes of equal significance, so the slowly varying high bytes of
+      // probabilities compress well; the checksum comes last and covers the compressed bytes.
+      check(H5Pset_shuffle(properties.get()), name);
+      check(H5Pset_deflate(properties.get(), kDeflateLevel), name);
+    }
     check(H5Pset_fletcher32(properties.get()), name);
   }
   Hdf5Handle dataset = checked(

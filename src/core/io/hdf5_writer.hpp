@@ -69,12 +69,22 @@ class Hdf5Writer {
   void unsigned_attribute(const std::string& name, std::uint64_t value) const;
   void string_dataset(const std::string& name, const std::string& value) const;
   void group(const std::string& name) const;
-  /// A dataset of `shape`; non-empty ones are chunked (at most kChunkBytes per chunk) with the
-  /// Fletcher-32 checksum, which every HDF5 reader verifies on every read.
+  /// What a non-empty dataset passes through besides the Fletcher-32 checksum, which every HDF5
+  /// reader verifies on every read: Compressed adds HDF5's shuffle and deflate filters (every HDF5
+  /// build with zlib reads them: h5py, MATLAB, h5dump).
+  enum class Filters { ChecksumOnly, Compressed };
+  /// A dataset of `shape`; non-empty ones are chunked: whole trailing dimensions, at most
+  /// kChunkBytes per chunk.
   void dataset(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type, hid_t memory_type,
-               const void* data) const;
+               const void* data, Filters filters = Filters::ChecksumOnly) const;
 
-  static constexpr std::uint64_t kChunkBytes = 16u << 20;
+  /// HDF5's default chunk cache size: a reader's chunk buffers are then reused from one chunk to
+  /// the next instead of being mapped afresh (larger chunks made loading bmw_parking's file a
+  /// quarter slower; BENCHMARKS.md, "Policy file sizes").
+  static constexpr std::uint64_t kChunkBytes = 1u << 20;
+  /// zlib level of Filters::Compressed: 1 compresses policy arrays almost as well as 4 at a
+  /// fraction of the time (BENCHMARKS.md, "Policy file sizes").
+  static constexpr unsigned kDeflateLevel = 1;
 
  private:
   void check(herr_t status, const std::string& what) const;

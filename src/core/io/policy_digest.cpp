@@ -23,14 +23,16 @@ class ContentDigest {
       add(word);
     }
   }
-  void add(const std::vector<double>& values) {
+  void add(StoredValues values) {
     add(std::uint64_t(values.size()));
-    for (double value : values) {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const double value = values[i];
       std::uint64_t bits = 0;
       std::memcpy(&bits, &value, sizeof bits);
       add(bits);
     }
   }
+  void add(const std::vector<double>& values) { add(StoredValues(values)); }
   template <typename Unsigned>
   void add(const std::vector<Unsigned>& values) {
     add(std::uint64_t(values.size()));
@@ -76,19 +78,19 @@ std::vector<double> input_points(const Grid& inputs) {
 }
 
 std::string policy_digest(const PolicyFileAttributes& attributes, const std::string& config_yaml,
-                          const Policy& policy) {
+                          const Policy& policy, StoredValues values, StoredValues upper_values) {
   ContentDigest digest;
   add_attributes(digest, attributes);
   digest.add(config_yaml);
   add_grid(digest, policy.states);
   add_grid(digest, policy.inputs);
-  digest.add(policy.values);
+  digest.add(values);
   digest.add(policy.input_index);
   digest.add(input_points(policy.inputs));
   std::vector<std::uint8_t> roles(policy.roles.size());
   for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = std::uint8_t(policy.roles[i]);
   digest.add(roles);
-  if (policy.stationary || policy.guarantee == Guarantee::System) digest.add(policy.upper_values);
+  if (policy.stationary || policy.guarantee == Guarantee::System) digest.add(upper_values);
   return digest.hex();
 }
 

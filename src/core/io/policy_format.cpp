@@ -6,6 +6,7 @@
 
 #include "amytiss/errors.hpp"
 #include "io/policy_digest.hpp"
+#include "io/policy_storage.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -128,7 +129,23 @@ void check_probabilities(const Hdf5Reader& reader, const std::string& name, cons
                   ", expected a probability in [0, 1]");
 }
 
+// Values are float64 (exact) or float32 (rounded outward), widened to double on reading.
+void check_value_type(const Hdf5Reader& reader, const std::string& name) {
+  const Hdf5Reader::ElementType type = reader.element_type(name);
+  if (type.type_class != H5T_FLOAT || (type.bytes != 4 && type.bytes != 8))
+    reader.fail("dataset '" + name + "' has the wrong element type (expected float64 or float32)");
+}
+
+// Input indices are uint8, uint16 or uint32 (the narrowest that holds the grid's inputs; files
+// of older builds: always uint32), widened to uint32 on reading.
+void check_index_type(const Hdf5Reader& reader) {
+  const Hdf5Reader::ElementType type = reader.element_type("/input_index");
+  if (type.type_class != H5T_INTEGER || type.is_signed || (type.bytes != 1 && type.bytes != 2 && type.bytes != 4))
+    reader.fail("dataset '/input_index' has the wrong element type (expected uint8, uint16 or uint32)");
+}
+
 void read_input_arrays(const Hdf5Reader& reader, Policy& policy) {
+  check_index_type(reader);
   policy.input_index = reader.numeric_dataset<std::uint32_t>("/input_index", H5T_INTEGER, H5T_NATIVE_UINT32,
                                                              cell_shape(policy.states, policy.horizon));
   for (std::size_t i = 0; i < policy.input_index.size(); ++i)
@@ -145,6 +162,7 @@ void read_input_arrays(const Hdf5Reader& reader, Policy& policy) {
 }
 
 void read_cell_arrays(const Hdf5Reader& reader, Policy& policy) {
+  check_value_type(reader, "/values");
   policy.values = reader.numeric_dataset<double>("/values", H5T_FLOAT, H5T_NATIVE_DOUBLE,
                                                  cell_shape(policy.states, policy.horizon + 1));
   check_probabilities(reader, "/values", policy.values);
@@ -159,6 +177,7 @@ void read_cell_arrays(const Hdf5Reader& reader, Policy& policy) {
     policy.roles.push_back(CellRole(roles[i]));
   }
   if (!policy.stationary && policy.guarantee != Guarantee::System) return;
+  check_value_type(reader, "/upper_values");
   policy.upper_values = reader.numeric_dataset<double>("/upper_values", H5T_FLOAT, H5T_NATIVE_DOUBLE,
                                                        upper_values_shape(policy));
   check_probabilities(reader, "/upper_values", policy.upper_values);
@@ -227,23 +246,24 @@ void write_policy_contents(const Hdf5Writer& writer, const Policy& policy, const
   attributes.converged = policy.stationary && policy.converged ? 1 : 0;
   if (policy.guarantee == Guarantee::System) attributes.guarantee = to_string(Guarantee::System);
   const std::string config_yaml = to_yaml(config);
+  const StoredValueArrays stored(policy, config.output.values);
 
-  write_attributes(writer, attributes, policy_digest(attributes, config_yaml, policy));
+  write_attributes(writer, attributes,
+                   policy_digest(attributes, config_yaml, policy, stored.values(), stored.upper_values()));
   writer.string_dataset("/config", config_yaml);
   write_grid(writer, "/states", policy.states);
   write_grid(writer, "/inputs", policy.inputs);
-  writer.dataset("/values", cell_shape(policy.states, policy.horizon + 1), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                 policy.values.data());
-  writer.dataset("/input_index", cell_shape(policy.states, policy.horizon), H5T_STD_U32LE, H5T_NATIVE_UINT32,
-                 policy.input_index.data());
+  stored.write(writer, "/values", cell_shape(policy.states, policy.horizon + 1), stored.values());
+  writer.dataset("/input_index", cell_shape(policy.states, policy.horizon), input_index_file_type(policy.inputs.size()),
+                 H5T_NATIVE_UINT32, policy.input_index.data(), Hdf5Writer::Filters::Compressed);
   const std::vector<double> input_values = input_points(policy.inputs);
   writer.dataset("/input_values", {hsize_t(policy.inputs.size()), hsize_t(policy.inputs.dims())}, H5T_IEEE_F64LE,
                  H5T_NATIVE_DOUBLE, input_values.data());
   static_assert(sizeof(CellRole) == sizeof(std::uint8_t), "roles are stored as uint8");
-  writer.dataset("/roles", per_cell_shape(policy.states), H5T_STD_U8LE, H5T_NATIVE_UINT8, policy.roles.data());
+  writer.dataset("/roles", per_cell_shape(policy.states), H5T_STD_U8LE, H5T_NATIVE_UINT8, policy.roles.data(),
+                 Hdf5Writer::Filters::Compressed);
   if (policy.stationary || policy.guarantee == Guarantee::System)
-    writer.dataset("/upper_values", upper_values_shape(policy), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                   policy.upper_values.data());
+    stored.write(writer, "/upper_values", upper_values_shape(policy), stored.upper_values());
 }
 
 LoadedPolicy read_policy_contents(const Hdf5Reader& reader) {
@@ -258,7 +278,7 @@ LoadedPolicy read_policy_contents(const Hdf5Reader& reader) {
   policy.inputs = read_grid(reader, "/inputs");
   if (policy.states.dims() == 0) reader.fail("'/states' has no dimensions");
   read_cell_arrays(reader, policy);
-  const std::string digest = policy_digest(attributes, loaded.config_yaml, policy);
+  const std::string digest = policy_digest(attributes, loaded.config_yaml, policy, policy.values, policy.upper_values);
   if (digest != stored_digest)
     reader.fail("corrupt: its contents give the digest " + digest + " but the file records " + stored_digest +
                 " (modified or damaged after it was written)");
