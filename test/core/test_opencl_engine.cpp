@@ -378,6 +378,8 @@ TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   EXPECT_EQ(names, expected);
   EXPECT_GT(report.phases[2].pairs_per_second, 0);
   EXPECT_GT(report.phases[3].multiply_adds, 0);
+  EXPECT_GT(report.phases[3].bytes, 0);
+  EXPECT_GT(report.measured_bandwidth_bytes_per_second, 0);  // measured with profile
   EXPECT_GT(report.device_bytes, a.pairs() * sizeof(float));
   EXPECT_FALSE(report.device.empty());
   EXPECT_EQ(policy.computed_by, report.device);
