@@ -515,6 +515,30 @@ TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
   std::filesystem::remove_all(cache);
 }
 
+// With profile the device's copy bandwidth is measured once and then read from the cache folder;
+// without profile nothing is measured.
+TEST(OpenClEngine, ProfileMeasuresTheBandwidthOnceAndCachesIt) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.4, 2));
+  const std::filesystem::path cache = fresh_test_directory("amytiss_bandwidth_cache_");
+  OpenClEngineOptions engine;
+  engine.kernel_cache_dir = cache.string();
+  SynthesisOptions profiled = cpu_options();
+  profiled.profile = true;
+  SynthesisReport first, second, unprofiled;
+  detail::synthesize_opencl(a, profiled, &first, engine);
+  EXPECT_GT(first.measured_bandwidth_bytes_per_second, 0);
+  EXPECT_NE(first.bandwidth_basis.find("measured now, cached in " + cache.string()), std::string::npos)
+      << first.bandwidth_basis;
+  detail::synthesize_opencl(a, profiled, &second, engine);
+  EXPECT_EQ(second.measured_bandwidth_bytes_per_second, first.measured_bandwidth_bytes_per_second);
+  EXPECT_EQ(second.bandwidth_basis.rfind("copy of ", 0), 0u) << second.bandwidth_basis;
+  EXPECT_EQ(second.bandwidth_basis.find("measured now"), std::string::npos) << second.bandwidth_basis;
+  detail::synthesize_opencl(a, cpu_options(), &unprofiled, engine);
+  EXPECT_EQ(unprofiled.measured_bandwidth_bytes_per_second, 0);
+  EXPECT_TRUE(unprofiled.bandwidth_basis.empty());
+  std::filesystem::remove_all(cache);
+}
+
 TEST(OpenClEngine, RobotReachAvoidFullGridAgreesWithReference) {
   // The robot reach-avoid example's grid (config/robot_reach_avoid.yaml): 1681 states x 441 inputs = 741,321 pairs. The horizon is 6 instead of
   // 16 only to keep the serial reference under ~10 s here; the T_d = 16 comparison is recorded in
