@@ -88,6 +88,11 @@ struct SynthesisReport {
   /// The device's double-precision multiply-add peak (0: unknown) and how it was derived.
   double peak_multiply_adds_per_second = 0;
   std::string peak_basis;
+  /// With profile on an OpenCL device: its copy bandwidth in bytes (read + written) per second,
+  /// measured by a copy kernel in the device setup (or cached from an earlier run), and how.
+  /// 0 otherwise.
+  double measured_bandwidth_bytes_per_second = 0;
+  std::string bandwidth_basis;
   std::size_t host_peak_bytes = 0;    ///< peak resident set of the process (VmHWM)
   std::vector<EngineNote> notes;      ///< engine and device choice, fallback, storage, chunking, ...
   /// Several devices or ranks (docs/scale_out.md): seconds spent exchanging the parts between

@@ -8,6 +8,7 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/enum_names.hpp"
 #include "amytiss/format.hpp"
+#include "amytiss/roofline.hpp"
 #include "amytiss/stopwatch.hpp"
 
 namespace amytiss::cli {
@@ -107,6 +108,41 @@ void print_phase_times(const SynthesisReport& report) {
                 format_seconds(step_seconds).c_str());
 }
 
+namespace {
+
+// The time steps share one intensity: they are one row, their times summed; each breakdown
+// (kernel, stage) is a row of its own.
+void print_roofline(const SynthesisReport& report) {
+  const double peak = report.peak_multiply_adds_per_second, bandwidth = report.measured_bandwidth_bytes_per_second;
+  if (peak <= 0 || bandwidth <= 0) return;
+  std::printf("  bandwidth %.1f GB/s measured: %s\n", bandwidth / 1e9, report.bandwidth_basis.c_str());
+  // Caches serve part of the operand bytes: the intensity is a lower bound and a phase may beat its roof.
+  std::printf("roofline (bandwidth %.1f GB/s measured, peak %.0f GMAC/s; MAC/B over operand bytes, a lower "
+              "bound of the intensity: %% roof may pass 100):\n", bandwidth / 1e9, peak / 1e9);
+  std::printf("  %-28s %12s %12s %8s %12s %8s\n", "phase", "MAC/B", "roof GMAC/s", "bound", "GMAC/s", "% roof");
+  auto print_row = [&](const std::string& name, double multiply_adds, double bytes, double seconds) {
+    if (multiply_adds <= 0 || bytes <= 0 || seconds <= 0) return;
+    const RooflinePoint point = roofline_point(peak, bandwidth, multiply_adds, bytes, seconds);
+    std::printf("  %-28s %12.4g %12.3f %8s %12.3f %8.1f\n", name.c_str(), point.intensity, point.roof / 1e9,
+                to_string(point.bound).c_str(), point.achieved / 1e9, 100.0 * point.fraction_of_roof);
+  };
+  double step_multiply_adds = 0, step_bytes = 0, step_seconds = 0;
+  std::size_t steps = 0;
+  for (const auto& phase : report.phases) {
+    if (phase.kind != PhaseKind::Step) continue;
+    step_multiply_adds += phase.multiply_adds;
+    step_bytes += phase.bytes;
+    step_seconds += phase.seconds;
+    ++steps;
+  }
+  print_row("time steps (" + std::to_string(steps) + ")", step_multiply_adds, step_bytes, step_seconds);
+  for (const auto& phase : report.phases)
+    if (phase.kind != PhaseKind::Step && !phase.is_setup())
+      print_row((phase.is_breakdown() ? "  " : "") + phase.name, phase.multiply_adds, phase.bytes, phase.seconds);
+}
+
+}  // namespace
+
 // Every kernel finishes before its phase's clock stops (profile), so the rates are the device's.
 void print_profile(const SynthesisReport& report) {
   const double peak = report.peak_multiply_adds_per_second;
@@ -136,6 +172,7 @@ void print_profile(const SynthesisReport& report) {
   std::printf("  device memory: %s, host peak (VmHWM): %s\n",
               format_bytes(double(report.device_bytes)).c_str(),
               format_bytes(double(std::max(report.host_peak_bytes, peak_resident_bytes()))).c_str());
+  print_roofline(report);
 }
 
 void print_value_summary(const Policy& policy) {

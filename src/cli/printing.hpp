@@ -24,7 +24,8 @@ bool print_progress(const Progress& progress, bool quiet);
 double compute_seconds(const SynthesisReport& report);
 /// The phases' wall times, the time steps summed into one line.
 void print_phase_times(const SynthesisReport& report);
-/// Per phase: seconds, pairs/s, multiply-adds, GMAC/s, share of the peak, GB/s; and the memory.
+/// Per phase: seconds, pairs/s, multiply-adds, GMAC/s, share of the peak, GB/s; the memory; and,
+/// with a peak and a measured bandwidth, the roofline of the steps and the breakdowns.
 void print_profile(const SynthesisReport& report);
 /// V_0 over the free cells; continuous-system bounds: min, mean and max of the lower bound, the
 /// upper bound and the gap; unbounded: also the upper bound and the gap.

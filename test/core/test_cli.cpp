@@ -99,6 +99,19 @@ TEST_F(CliTest, ProfilePrintsThePhaseTable) {
   EXPECT_CONTAINS(result.out, "host peak (VmHWM)");
 }
 
+// On an OpenCL device the profile measures the bandwidth and prints the steps' roofline.
+TEST_F(CliTest, ProfileOnADevicePrintsTheMeasuredBandwidthAndTheRoofline) {
+  const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device cpu --quiet --profile");
+  ASSERT_EQ(0, result.exit_code) << result.err;
+  EXPECT_CONTAINS(result.out, "GB/s measured: copy of ");
+  EXPECT_CONTAINS(result.out, "roofline (bandwidth ");
+  const std::string row = "time steps (4) ";
+  const std::size_t at = result.out.find(row);
+  ASSERT_NE(std::string::npos, at) << result.out;
+  const std::string line = result.out.substr(at, result.out.find('\n', at) - at);
+  EXPECT_TRUE(line.find(" memory ") != std::string::npos || line.find(" compute ") != std::string::npos) << line;
+}
+
 TEST_F(CliTest, CompareReferencePrintsSpeedUpAndDifference) {
   const CommandResult result = synth("--config " + quote(kTinyConfig) +
                                      " --device reference --quiet --compare-reference");

@@ -378,6 +378,8 @@ TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   EXPECT_EQ(names, expected);
   EXPECT_GT(report.phases[2].pairs_per_second, 0);
   EXPECT_GT(report.phases[3].multiply_adds, 0);
+  EXPECT_GT(report.phases[3].bytes, 0);
+  EXPECT_GT(report.measured_bandwidth_bytes_per_second, 0);  // measured with profile
   EXPECT_GT(report.device_bytes, a.pairs() * sizeof(float));
   EXPECT_FALSE(report.device.empty());
   EXPECT_EQ(policy.computed_by, report.device);
@@ -510,6 +512,30 @@ TEST(OpenClEngine, ProgramBinaryCacheIsUsedAndACorruptEntryIsIgnored) {
   const Policy uncached = detail::synthesize_opencl(a, cpu_options(), &uncached_report, engine);
   EXPECT_FALSE(logged(uncached_report, "kernel build:")) << "\"-\" disables the cache";
   EXPECT_EQ(uncached.values, first.values);
+  std::filesystem::remove_all(cache);
+}
+
+// With profile the device's copy bandwidth is measured once and then read from the cache folder;
+// without profile nothing is measured.
+TEST(OpenClEngine, ProfileMeasuresTheBandwidthOnceAndCachesIt) {
+  const Abstraction a = from_yaml(robot_reach_avoid_yaml(1.0, 0.4, 2));
+  const std::filesystem::path cache = fresh_test_directory("amytiss_bandwidth_cache_");
+  OpenClEngineOptions engine;
+  engine.kernel_cache_dir = cache.string();
+  SynthesisOptions profiled = cpu_options();
+  profiled.profile = true;
+  SynthesisReport first, second, unprofiled;
+  detail::synthesize_opencl(a, profiled, &first, engine);
+  EXPECT_GT(first.measured_bandwidth_bytes_per_second, 0);
+  EXPECT_NE(first.bandwidth_basis.find("measured now, cached in " + cache.string()), std::string::npos)
+      << first.bandwidth_basis;
+  detail::synthesize_opencl(a, profiled, &second, engine);
+  EXPECT_EQ(second.measured_bandwidth_bytes_per_second, first.measured_bandwidth_bytes_per_second);
+  EXPECT_EQ(second.bandwidth_basis.rfind("copy of ", 0), 0u) << second.bandwidth_basis;
+  EXPECT_EQ(second.bandwidth_basis.find("measured now"), std::string::npos) << second.bandwidth_basis;
+  detail::synthesize_opencl(a, cpu_options(), &unprofiled, engine);
+  EXPECT_EQ(unprofiled.measured_bandwidth_bytes_per_second, 0);
+  EXPECT_TRUE(unprofiled.bandwidth_basis.empty());
   std::filesystem::remove_all(cache);
 }
 

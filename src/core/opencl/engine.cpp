@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "opencl/device_bandwidth.hpp"
 #include "opencl/device_peak.hpp"
 #include "opencl/factored/sweep.hpp"
 #include "opencl/layout.hpp"
@@ -103,6 +104,11 @@ Policy run_on_device(const Abstraction& a, const DeviceInfo& device, const std::
   rep.peak_multiply_adds_per_second = peak.multiply_adds_per_second;
   rep.peak_basis = peak.basis;
   DeviceSession session = open_session(device);
+  if (options.profile) {  // the roofline's bandwidth; its cost stays out of unprofiled runs
+    const DeviceBandwidth bandwidth = measured_copy_bandwidth(device, session, engine_options.kernel_cache_dir);
+    rep.measured_bandwidth_bytes_per_second = bandwidth.bytes_per_second;
+    rep.bandwidth_basis = bandwidth.basis;
+  }
   reporter.phase(PhaseKind::DeviceSetup, "device setup", seconds_since(phase_start));
   if (!factored) return run_dense(a, device, session, options, engine_options, reporter);
   rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
