@@ -14,14 +14,32 @@ struct PlaneBox {
   Interval x, y;
 };
 
-/// A box that holds every point of the body for every pose with the reference point in x × y (m)
-/// and the heading in `yaw` (rad). The body's four corners relative to the reference point are
-/// rotated with interval cos and sin of `yaw` (outward rounded); their hull, shifted by x × y,
-/// encloses the rectangle (the convex hull of its corners) at every such pose.
+/// A rectangle of the car's frame (m): `rear..front` along the heading (forward > 0) from the
+/// reference point, `right..left` across it (left > 0).
+struct BodyPiece {
+  double rear, front, right, left;
+};
+
+/// The body, `length` x `width` from `rear_overhang` behind the reference point, cut into pieces
+/// of side at most width/2 (2 across, ceil(2 length / width) along): their union is the body.
+std::vector<BodyPiece> body_pieces(const Footprint& footprint);
+
+/// A box that holds every point of `piece` for every pose with the reference point in x × y (m)
+/// and the heading in `yaw` (rad). The piece's four corners are rotated with interval cos and sin
+/// of `yaw` (outward rounded); their hull, shifted by x × y, encloses the rectangle (the convex
+/// hull of its corners) at every such pose.
+PlaneBox piece_box(const BodyPiece& piece, const Interval& x, const Interval& y, const Interval& yaw);
+
+/// piece_box() of the whole body: one box around the footprint swept over the poses.
 PlaneBox footprint_box(const Footprint& footprint, const Interval& x, const Interval& y, const Interval& yaw);
 
 /// Whether `box` and one of the obstacles share a point (contact counts: the test is conservative).
 bool meets_obstacle(const PlaneBox& box, const Region& obstacles);
+
+/// Whether the body (its body_pieces()) may touch an obstacle at some pose of x × y × yaw: whether
+/// the box of one of the pieces meets one (tighter than footprint_box() when the heading is oblique).
+bool body_may_touch(const std::vector<BodyPiece>& pieces, const Interval& x, const Interval& y, const Interval& yaw,
+                    const Region& obstacles);
 
 /// Per cell of `states` (its box: the point ± eta/2 in every dimension): whether the body at some
 /// pose of the cell may touch an obstacle. All false without `spec.obstacles`.

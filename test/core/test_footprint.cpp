@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -39,7 +40,7 @@ Footprint car(double length, double width, double rear_overhang) {
   return footprint;
 }
 
-TEST(FootprintBox, HoldsTheBodyAtSampledPosesOfTheCell) {
+TEST(FootprintBox, HoldsTheBodyAtSampledPosesOfTheCellAndSoDoThePieces) {
   std::mt19937_64 random(kSeed);
   auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };
   for (int trial = 0; trial < 300; ++trial) {
@@ -48,6 +49,9 @@ TEST(FootprintBox, HoldsTheBodyAtSampledPosesOfTheCell) {
     const double x = uniform(-10, 10), y = uniform(-10, 10), yaw = uniform(-7, 7);
     const double hx = uniform(0.0, 1.0), hy = uniform(0.0, 1.0), hyaw = uniform(0.0, trial % 10 == 0 ? 4.0 : 0.8);
     const PlaneBox box = footprint_box(footprint, {x - hx, x + hx}, {y - hy, y + hy}, {yaw - hyaw, yaw + hyaw});
+    std::vector<PlaneBox> piece_boxes;
+    for (const BodyPiece& piece : body_pieces(footprint))
+      piece_boxes.push_back(piece_box(piece, {x - hx, x + hx}, {y - hy, y + hy}, {yaw - hyaw, yaw + hyaw}));
     for (int sample = 0; sample < 200; ++sample) {
       const double px = uniform(x - hx, x + hx), py = uniform(y - hy, y + hy);
       const double heading = uniform(yaw - hyaw, yaw + hyaw);
@@ -62,6 +66,11 @@ TEST(FootprintBox, HoldsTheBodyAtSampledPosesOfTheCell) {
       ASSERT_LE(bx, box.x.hi + kSampleRounding) << "trial " << trial << " sample " << sample;
       ASSERT_GE(by, box.y.lo - kSampleRounding) << "trial " << trial << " sample " << sample;
       ASSERT_LE(by, box.y.hi + kSampleRounding) << "trial " << trial << " sample " << sample;
+      const bool in_a_piece = std::any_of(piece_boxes.begin(), piece_boxes.end(), [&](const PlaneBox& piece) {
+        return bx >= piece.x.lo - kSampleRounding && bx <= piece.x.hi + kSampleRounding &&
+               by >= piece.y.lo - kSampleRounding && by <= piece.y.hi + kSampleRounding;
+      });
+      ASSERT_TRUE(in_a_piece) << "trial " << trial << " sample " << sample;
     }
   }
 }
@@ -84,6 +93,22 @@ TEST(FootprintBox, HeadingZeroAndNinetyDegreesByHand) {
   EXPECT_FALSE(meets_obstacle(east, Region(box({4.1, 0}, {5, 1}))));
   EXPECT_TRUE(meets_obstacle(east, Region(box({3.9, 0}, {5, 1}))));
   EXPECT_TRUE(meets_obstacle(east, Region({box({-9, -9}, {-8, -8}), box({3.9, 1.9}, {5, 5})})));
+}
+
+TEST(FootprintBox, PiecesCoverTheBodyAndCutTheObliqueCorners) {
+  // Length 4 from the reference point, width 2: 4 pieces along (side <= 1) times 2 across.
+  const Footprint footprint = car(4.0, 2.0, 0.0);
+  const std::vector<BodyPiece> pieces = body_pieces(footprint);
+  ASSERT_EQ(pieces.size(), 8u);
+  EXPECT_EQ(pieces.front().rear, 0.0);
+  EXPECT_EQ(pieces.back().front, 4.0);
+  // At 45 degrees the body lies along the diagonal y = x; its whole box reaches (3.54, -0.71), but
+  // (3.3, -0.5) is 2.69 m from the diagonal, further than the half width of 1 m.
+  const Interval origin = Interval::point(0.0), diagonal = Interval::point(M_PI / 4);
+  const Region beside(box({3.2, -0.6}, {3.4, -0.4}));
+  EXPECT_TRUE(meets_obstacle(footprint_box(footprint, origin, origin, diagonal), beside));
+  EXPECT_FALSE(body_may_touch(pieces, origin, origin, diagonal, beside));
+  EXPECT_TRUE(body_may_touch(pieces, origin, origin, diagonal, Region(box({1.9, 1.9}, {2.1, 2.1}))));
 }
 
 // States (x, y, yaw): x = 0..10 (eta 1), one y point 0 (cell [-0.5, 0.5]), one yaw point 0 (cell
