@@ -88,6 +88,15 @@ struct IntegratorConfig {
 
 enum class SpecType { Safety, Reachability, ReachAvoid };
 
+/// The car's body for `spec.obstacles` (docs/configuration.md): which state components are the
+/// reference point's position and heading, and the body, a rectangle in the car's frame.
+struct Footprint {
+  std::vector<unsigned> pose;  ///< [ix, iy, iyaw]: state indices of x (m), y (m), heading (rad)
+  double length = 0.0;         ///< m along the heading, > rear_overhang
+  double width = 0.0;          ///< m across the heading, centred on the heading line, > 0
+  double rear_overhang = 0.0;  ///< m the body reaches behind the reference point, >= 0
+};
+
 /// What the values guarantee (docs/semantics.md): `abstraction`, exact values of the finite MDP built
 /// from the cells' points; `system`, a lower and an upper bound of the probability for the
 /// continuous system from every state of a cell, through the interval MDP of the cells.
@@ -106,6 +115,10 @@ struct SpecConfig {
   std::optional<Region> safe;    ///< safety; absent: the whole grid
   std::optional<Region> target;  ///< reachability, reach_avoid
   std::optional<Region> avoid;   ///< reach_avoid (absent: empty)
+  /// Safety and reach_avoid, with `footprint`: 2-d boxes {lb: [x, y], ub: [x, y]} in the world
+  /// frame (m); a cell whose body may touch one of them is avoided (docs/semantics.md).
+  std::optional<Region> obstacles;
+  std::optional<Footprint> footprint;  ///< given exactly when `obstacles` is
 };
 
 enum class DeviceKind { Auto, Cpu, Gpu, Reference };

@@ -35,6 +35,13 @@ std::string region_yaml(const Region& region) {
   return text + "]";
 }
 
+std::string footprint_yaml(const Footprint& footprint) {
+  std::string pose = "[";
+  for (std::size_t i = 0; i < footprint.pose.size(); ++i) pose += (i ? ", " : "") + std::to_string(footprint.pose[i]);
+  return "{pose: " + pose + "], length: " + format_number(footprint.length) + ", width: " +
+         format_number(footprint.width) + ", rear_overhang: " + format_number(footprint.rear_overhang) + "}";
+}
+
 // compute and output: how the result is computed and stored.
 std::string unhashed_yaml(const Config& config) {
   std::string text;
@@ -109,6 +116,9 @@ std::string canonical_yaml(const Config& config, bool with_unhashed_sections) {
   if (config.spec.safe) text += "  safe: " + region_yaml(*config.spec.safe) + "\n";
   if (config.spec.target) text += "  target: " + region_yaml(*config.spec.target) + "\n";
   if (config.spec.avoid) text += "  avoid: " + region_yaml(*config.spec.avoid) + "\n";
+  // Printed only when given, so configurations without obstacles keep their text and hash.
+  if (config.spec.obstacles) text += "  obstacles: " + region_yaml(*config.spec.obstacles) + "\n";
+  if (config.spec.footprint) text += "  footprint: " + footprint_yaml(*config.spec.footprint) + "\n";
   // Left out when it is the default, so configurations without the key keep their text and hash.
   if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
   // compute and output change how the result is computed or stored, not the result: no hash.

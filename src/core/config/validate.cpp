@@ -15,6 +15,7 @@ namespace {
 
 using detail::check_finite_list;
 using detail::check_noise;
+using detail::check_obstacles;
 using detail::fail;
 using detail::format_list;
 using detail::indexed;
@@ -246,6 +247,7 @@ void check_spec(const SpecConfig& spec, const GridSpec& states) {
       }
       break;
   }
+  check_obstacles(spec, states.lb.size());
 }
 
 void check_compute(const ComputeConfig& compute) {

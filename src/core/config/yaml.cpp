@@ -181,8 +181,26 @@ NoiseConfig read_noise(const YAML::Node& noise) {
   return config;
 }
 
+Footprint read_footprint(const YAML::Node& node) {
+  const char* const example = "footprint: {pose: [0, 1, 2], length: 4.9, width: 1.9, rear_overhang: 1.0}";
+  check_keys(node, "spec.footprint", {"pose", "length", "width", "rear_overhang"}, example);
+  Footprint footprint;
+  const YAML::Node pose = required(node, "pose", "spec.footprint.pose", example);
+  if (!pose.IsSequence()) fail("spec.footprint.pose", node_text(pose), "a list of state indices", example);
+  for (std::size_t i = 0; i < pose.size(); ++i)
+    footprint.pose.push_back(read_count(pose[i], indexed("spec.footprint.pose", i), example));
+  auto length_of = [&](const char* name) {
+    const std::string key = std::string("spec.footprint.") + name;
+    return read_number(required(node, name, key, example), key, example);
+  };
+  footprint.length = length_of("length");
+  footprint.width = length_of("width");
+  footprint.rear_overhang = length_of("rear_overhang");
+  return footprint;
+}
+
 SpecConfig read_spec(const YAML::Node& spec) {
-  check_keys(spec, "spec", {"type", "horizon", "tolerance", "safe", "target", "avoid"},
+  check_keys(spec, "spec", {"type", "horizon", "tolerance", "safe", "target", "avoid", "obstacles", "footprint"},
              "spec: {type: safety, horizon: 8}");
   SpecConfig config;
   config.type = read_enum<SpecType>(required(spec, "type", "spec.type", "type: reach_avoid"), "spec.type",
@@ -196,6 +214,9 @@ SpecConfig read_spec(const YAML::Node& spec) {
   if (present(spec["safe"])) config.safe = read_region(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
   if (present(spec["target"])) config.target = read_region(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
   if (present(spec["avoid"])) config.avoid = read_region(spec["avoid"], "spec.avoid", "{lb: [-2, -2], ub: [2, 2]}");
+  if (present(spec["obstacles"]))
+    config.obstacles = read_region(spec["obstacles"], "spec.obstacles", "{lb: [3, 0], ub: [4, 2]}");
+  if (present(spec["footprint"])) config.footprint = read_footprint(spec["footprint"]);
   return config;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "amytiss/footprint.hpp"
+
 namespace amytiss::detail {
 namespace {
 
@@ -136,12 +138,19 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
                        [&](const Box& box) { return overlaps(cell_lo, cell_hi, box, slack); });
   };
   const bool lower = bound == Bound::Lower;
+  // The lower bound avoids every cell whose body may touch an obstacle at some pose; the upper
+  // bound would need "touches at every pose" and, soundly, avoids no cell for obstacles.
+  const std::vector<bool> touched = lower ? obstacle_cells(states, spec) : std::vector<bool>(states.size(), false);
   std::vector<CellRole> roles(states.size(), CellRole::Free);
   for (std::size_t cell = 0; cell < states.size(); ++cell) {
     states.multi_index(cell, multi.data());
     for (std::size_t d = 0; d < dims; ++d) {
       cell_lo[d] = states.lb()[d] + (double(multi[d]) - 0.5) * states.eta()[d];
       cell_hi[d] = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
+    }
+    if (touched[cell]) {
+      roles[cell] = CellRole::FixedZero;
+      continue;
     }
     if (spec.type == SpecType::Safety) {
       if (spec.safe && !(lower ? inside(*spec.safe) : meets(*spec.safe))) roles[cell] = CellRole::FixedZero;

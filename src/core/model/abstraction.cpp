@@ -4,6 +4,7 @@
 #include <string>
 
 #include "amytiss/errors.hpp"
+#include "amytiss/footprint.hpp"
 
 namespace amytiss {
 namespace {
@@ -24,13 +25,14 @@ void require_region(const Region& region, std::size_t dims) {
 std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
   std::vector<CellRole> roles(states.size(), CellRole::Free);
   const std::size_t dims = states.dims();
+  // The footprint test judges the whole cell, not only its point: no pose of the cell may touch.
+  const std::vector<bool> touched = obstacle_cells(states, spec);
   switch (spec.type) {
     case SpecType::Safety:
-      if (spec.safe) {
-        require_region(*spec.safe, dims);
-        for (std::size_t cell = 0; cell < roles.size(); ++cell)
-          if (!states.point_in_region(cell, *spec.safe)) roles[cell] = CellRole::FixedZero;
-      }
+      if (spec.safe) require_region(*spec.safe, dims);
+      for (std::size_t cell = 0; cell < roles.size(); ++cell)
+        if (touched[cell] || (spec.safe && !states.point_in_region(cell, *spec.safe)))
+          roles[cell] = CellRole::FixedZero;
       break;
     case SpecType::Reachability:
     case SpecType::ReachAvoid: {
@@ -39,7 +41,7 @@ std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
       const bool with_avoid = spec.type == SpecType::ReachAvoid && spec.avoid.has_value();
       if (with_avoid) require_region(*spec.avoid, dims);
       for (std::size_t cell = 0; cell < roles.size(); ++cell) {
-        if (with_avoid && states.point_in_region(cell, *spec.avoid))
+        if (touched[cell] || (with_avoid && states.point_in_region(cell, *spec.avoid)))
           roles[cell] = CellRole::FixedZero;
         else if (states.point_in_region(cell, *spec.target))
           roles[cell] = CellRole::FixedOne;
