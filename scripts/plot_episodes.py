@@ -134,6 +134,11 @@ def draw_sets(ax, policy, suffix=""):
             x, y, w, h = box_xy(box)
             # One legend entry per set, not per box.
             ax.add_patch(Rectangle((x, y), w, h, label=name + suffix if index == 0 else None, **style))
+    # Obstacles of the configuration (world frame x, y: the footprint's reference point axes).
+    for index, box in enumerate(boxes_of(spec.get("obstacles") or [])):
+        x, y, w, h = box_xy(box)
+        ax.add_patch(Rectangle((x, y), w, h, fc="0.4", alpha=0.5, hatch="//",
+                               label="obstacles (configuration)" if index == 0 else None))
     ax.set_xlim(lo[0] - eta[0], hi[0] + eta[0])
     ax.set_ylim(y0 - (eta[1] if len(eta) > 1 else 0.5), y1 + (eta[1] if len(eta) > 1 else 0.5))
 
@@ -155,6 +160,11 @@ def main():
     name = policy["config"].get("name", "policy")
 
     footprint = [float(v) for v in args.footprint.split(",")] if args.footprint else None
+    # Without --footprint, the configuration's own body (spec.footprint) when it has one.
+    body = (policy["config"].get("spec", {}) or {}).get("footprint")
+    if footprint is None and body:
+        footprint = [float(body["length"]), float(body["width"]), float(body["rear_overhang"])] + \
+                    [float(i) for i in body["pose"]]
     scene = {}
     if args.scene:
         with open(args.scene) as f:
