@@ -13,6 +13,8 @@
 namespace amytiss {
 namespace {
 
+using test_support::expect_error;
+
 const char* const kBase = R"(
 name: base
 states: {lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}
@@ -26,17 +28,6 @@ spec: {type: safety, horizon: 8}
 
 YAML::Node base() { return YAML::Load(kBase); }
 
-/// Parses `root` and expects a ConfigError for `key` whose message contains `fragment`.
-void expect_error(const YAML::Node& root, const std::string& key, const std::string& fragment) {
-  try {
-    config_from_yaml(root);
-    ADD_FAILURE() << "no ConfigError; expected key " << key << " with '" << fragment << "'";
-  } catch (const ConfigError& error) {
-    EXPECT_EQ(error.key(), key) << error.what();
-    EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos)
-        << "message: " << error.what() << "\nexpected fragment: " << fragment;
-  }
-}
 
 TEST(Config, BaseParsesWithDefaults) {
   const Config config = config_from_yaml(base());

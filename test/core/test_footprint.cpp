@@ -180,16 +180,6 @@ spec:
   footprint: {pose: [0, 1, 2], length: 4.0, width: 2.0, rear_overhang: 1.0}
 )yaml";
 
-void expect_error(const YAML::Node& root, const std::string& key, const std::string& fragment) {
-  try {
-    config_from_yaml(root);
-    ADD_FAILURE() << "no ConfigError; expected key " << key << " with '" << fragment << "'";
-  } catch (const ConfigError& error) {
-    EXPECT_EQ(error.key(), key) << error.what();
-    EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos)
-        << "message: " << error.what() << "\nexpected fragment: " << fragment;
-  }
-}
 
 YAML::Node car_with(const std::string& key, const std::string& value) {
   YAML::Node root = YAML::Load(kCar);

@@ -27,6 +27,7 @@ constexpr unsigned kFormatVersion = 2;  // the version this build writes
 
 using test_support::tiny_config;
 using test_support::tiny_policy;
+using test_support::refusal;
 
 class PolicyFileTest : public ::testing::Test {
  protected:
@@ -39,17 +40,6 @@ class PolicyFileTest : public ::testing::Test {
   fs::path directory_;
 };
 
-// Runs `action` and returns the PolicyFileError message; fails the test when none is thrown.
-template <typename Action>
-std::string refusal(Action action) {
-  try {
-    action();
-  } catch (const PolicyFileError& error) {
-    return error.what();
-  }
-  ADD_FAILURE() << "no PolicyFileError was thrown";
-  return "";
-}
 
 void expect_same_grid(const Grid& expected, const Grid& actual) {
   EXPECT_EQ(expected.lb(), actual.lb());

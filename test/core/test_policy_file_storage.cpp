@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 using detail::Hdf5Handle;
 using test_support::tiny_config;
 using test_support::tiny_policy;
+using test_support::refusal;
 
 class PolicyFileStorageTest : public ::testing::Test {
  protected:
@@ -35,16 +36,6 @@ class PolicyFileStorageTest : public ::testing::Test {
   fs::path directory_;
 };
 
-template <typename Action>
-std::string refusal(Action action) {
-  try {
-    action();
-  } catch (const PolicyFileError& error) {
-    return error.what();
-  }
-  ADD_FAILURE() << "no PolicyFileError was thrown";
-  return "";
-}
 
 Hdf5Handle open_file(const std::string& file, unsigned flags) {
   Hdf5Handle handle(H5Fopen(file.c_str(), flags, H5P_DEFAULT), H5Fclose);

@@ -26,6 +26,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/format.hpp"
 #include "amytiss/config.hpp"
+#include "amytiss/errors.hpp"
 #include "amytiss/model.hpp"
 
 namespace amytiss {
@@ -237,6 +238,30 @@ inline std::string robot_disturbance_yaml() {
          "noise: {type: additive, distribution: normal, covariance: [0.75, 0.75],\n"
          "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
          "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
+}
+
+/// Parses `root` and expects a ConfigError for `key` whose message contains `fragment`.
+inline void expect_error(const YAML::Node& root, const std::string& key, const std::string& fragment) {
+  try {
+    config_from_yaml(root);
+    ADD_FAILURE() << "no ConfigError; expected key " << key << " with '" << fragment << "'";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(error.key(), key) << error.what();
+    EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos)
+        << "message: " << error.what() << "\nexpected fragment: " << fragment;
+  }
+}
+
+/// Runs `action` and returns the PolicyFileError message; fails the test when none is thrown.
+template <typename Action>
+std::string refusal(Action action) {
+  try {
+    action();
+  } catch (const PolicyFileError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "no PolicyFileError was thrown";
+  return "";
 }
 
 }  // namespace test_support
