@@ -116,8 +116,8 @@ Policy run_backward_bounds(const Abstraction& a, IntervalStep& lower, IntervalSt
     policy.upper_values.assign(policy.values.size(), 0.0);
     policy.input_index.assign(std::size_t(a.horizon) * cells, 0);
     for (std::size_t x = 0; x < cells; ++x) {
-      policy.values[std::size_t(a.horizon) * cells + x] = lower.role_value(lower.roles()[x]);
-      policy.upper_values[std::size_t(a.horizon) * cells + x] = upper.role_value(upper.roles()[x]);
+      policy.values[std::size_t(a.horizon) * cells + x] = a.terminal_value(lower.roles()[x]);
+      policy.upper_values[std::size_t(a.horizon) * cells + x] = a.terminal_value(upper.roles()[x]);
     }
     std::vector<std::uint32_t> upper_inputs(cells);
     reporter.start_steps();

@@ -39,12 +39,6 @@ void IntervalStep::use_stage_caches(ProductScratch& scratch) const {
     if (stage_cache_entries_[d]) scratch.caches[d] = {stage_caches_[d].get(), rows_.suffix_classes(d), 0};
 }
 
-double IntervalStep::role_value(CellRole role) const {
-  if (role == CellRole::FixedOne) return 1.0;
-  if (role == CellRole::FixedZero) return 0.0;
-  return a_.spec == SpecType::Safety ? 1.0 : 0.0;
-}
-
 double IntervalStep::expectation(std::size_t row, const double* in, ProductScratch& scratch) const {
   DimensionView* views = scratch.views.data();
   rows_.dimensions(row, views);
@@ -69,7 +63,7 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
     for (std::size_t cell = first; cell < last; ++cell) {
       chosen[cell] = 0;
       if (roles_[cell] != CellRole::Free) {
-        out[cell] = role_value(roles_[cell]);
+        out[cell] = a_.terminal_value(roles_[cell]);
         continue;
       }
       double best = -1.0;
@@ -92,7 +86,7 @@ void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* 
     use_stage_caches(scratch);
     for (std::size_t cell = first; cell < last; ++cell)
       out[cell] = roles_[cell] == CellRole::Free ? worst_case(cell, controller[cell], in, scratch)
-                                                 : role_value(roles_[cell]);
+                                                 : a_.terminal_value(roles_[cell]);
   });
 }
 

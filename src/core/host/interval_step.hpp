@@ -30,8 +30,6 @@ class IntervalStep : public BellmanStep {
   /// The O-maximisation's outward rounding keeps the sequences apart by at most this.
   double resolution() const override { return 1e-12; }
   const std::vector<CellRole>& roles() const { return roles_; }
-  /// The value of a fixed cell, and a Free cell's terminal value V_{T_d}.
-  double role_value(CellRole role) const;
 
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;

@@ -10,10 +10,10 @@ namespace amytiss::detail {
 namespace {
 
 // Free cells start at `free_value`, fixed cells hold their role's value.
-std::vector<double> start_values(const IntervalStep& step, double free_value) {
+std::vector<double> start_values(const Abstraction& a, const IntervalStep& step, double free_value) {
   std::vector<double> values(step.roles().size());
   for (std::size_t x = 0; x < values.size(); ++x)
-    values[x] = step.roles()[x] == CellRole::Free ? free_value : step.role_value(step.roles()[x]);
+    values[x] = step.roles()[x] == CellRole::Free ? free_value : a.terminal_value(step.roles()[x]);
   return values;
 }
 
@@ -25,8 +25,9 @@ double largest_difference(const std::vector<double>& above, const std::vector<do
 
 // Iterates the stationary controller's pessimistic step from 0 while it moves: every iterate is a
 // lower bound of what the controller guarantees.
-unsigned certify(IntervalStep& lower, const std::vector<std::uint32_t>& controller, std::vector<double>& values) {
-  values = start_values(lower, 0.0);
+unsigned certify(const Abstraction& a, IntervalStep& lower, const std::vector<std::uint32_t>& controller,
+                 std::vector<double>& values) {
+  values = start_values(a, lower, 0.0);
   std::vector<double> next(values.size());
   unsigned steps = 0;
   while (steps < kMaxRobustIterations) {
@@ -44,7 +45,7 @@ unsigned certify(IntervalStep& lower, const std::vector<std::uint32_t>& controll
 Policy solve_unbounded_bounds(const Abstraction& a, IntervalStep& lower, IntervalStep& upper, const UnboundedRun& run,
                               SynthesisReport& report) {
   const std::size_t n = a.states.size();
-  std::vector<double> low = start_values(lower, 0.0), high = start_values(upper, 1.0);
+  std::vector<double> low = start_values(a, lower, 0.0), high = start_values(a, upper, 1.0);
   std::vector<double> next_low(n), next_high(n);
   std::vector<std::uint32_t> controller(n, 0), unused(n);
   unsigned iterations = 0;
@@ -71,7 +72,7 @@ Policy solve_unbounded_bounds(const Abstraction& a, IntervalStep& lower, Interva
   const auto certification_start = SteadyClock::now();
   Policy policy;
   std::vector<double> certified;
-  const unsigned steps = certify(lower, controller, certified);
+  const unsigned steps = certify(a, lower, controller, certified);
   report.phases.push_back({"policy certification (" + std::to_string(steps) + " steps)",
                            seconds_since(certification_start), 0, 0});
   policy.values = certified;
