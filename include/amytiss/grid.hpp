@@ -28,6 +28,9 @@ class Grid {
 
   /// Representative coordinate of index k along dim: lb + k*eta.
   double coordinate(std::size_t dim, std::size_t k) const { return lb_[dim] + double(k) * eta_[dim]; }
+  /// The face between cells k-1 and k along dim: lb + (k - 1/2)*eta. Cell k spans
+  /// [face(dim, k), face(dim, k + 1)]; neighbouring cells share the exact same face.
+  double face(std::size_t dim, std::int64_t k) const { return lb_[dim] + (double(k) - 0.5) * eta_[dim]; }
   /// Writes the point of a flat index into out[0..dims).
   void point(std::size_t flat, double* out) const;
   std::vector<double> point(std::size_t flat) const;

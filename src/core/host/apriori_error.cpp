@@ -102,9 +102,8 @@ std::vector<IntervalBox> boxes_with_free_cells(const Abstraction& abstraction, c
     for (std::size_t d = n, rest = box; d-- > 0; rest /= boxes_along[d]) {
       const std::size_t first = (rest % boxes_along[d]) * side[d];
       const std::size_t last = std::min(first + side[d], states.count(d)) - 1;
-      const double lb = states.lb()[d], eta = states.eta()[d];
-      interval_box[d] =
-          Interval(round_down(lb + (double(first) - 0.5) * eta), round_up(lb + (double(last) + 0.5) * eta));
+      interval_box[d] = Interval(round_down(states.face(d, std::int64_t(first))),
+                                 round_up(states.face(d, std::int64_t(last) + 1)));
     }
     result.push_back(std::move(interval_box));
   }

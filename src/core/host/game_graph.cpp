@@ -15,8 +15,8 @@ namespace {
 // masses sum to 1 - 1e-16 in double keep their whole mass all the same).
 bool support_kept(const Grid& states, std::size_t dim, std::int64_t first, std::int64_t last, double mean,
                   double scale, std::pair<double, double> unit_support) {
-  const double lo = states.lb()[dim] + (double(first) - 0.5) * states.eta()[dim];
-  const double hi = states.lb()[dim] + (double(last) + 0.5) * states.eta()[dim];
+  const double lo = states.face(dim, first);
+  const double hi = states.face(dim, last + 1);
   if (scale == 0.0) return lo <= mean && mean < hi;
   return mean + scale * unit_support.first >= lo && mean + scale * unit_support.second <= hi;
 }

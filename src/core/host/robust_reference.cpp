@@ -31,9 +31,8 @@ std::vector<std::vector<DimensionBounds>> row_bounds(const RobustProblem& p) {
         p.mean_box(cell, u, w, lo.data(), hi.data());
         std::vector<DimensionBounds>& row = rows[(cell * inputs + u) * disturbances + w];
         for (std::size_t d = 0; d < dims; ++d) {
-          const double face_lo = p.states.lb()[d] + (double(multi[d]) - 0.5) * p.states.eta()[d];
-          const double face_hi = p.states.lb()[d] + (double(multi[d]) + 0.5) * p.states.eta()[d];
-          const MassInterval scale = per_dimension[d].scale_range(face_lo, face_hi);
+          const auto k = std::int64_t(multi[d]);
+          const MassInterval scale = per_dimension[d].scale_range(p.states.face(d, k), p.states.face(d, k + 1));
           row.push_back(per_dimension[d].dimension_bounds(p.states, lo[d], hi[d], scale.lo, scale.hi));
         }
       }
@@ -145,8 +144,8 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
   for (std::size_t cell = 0; cell < states.size(); ++cell) {
     states.multi_index(cell, multi.data());
     for (std::size_t d = 0; d < dims; ++d) {
-      cell_lo[d] = states.lb()[d] + (double(multi[d]) - 0.5) * states.eta()[d];
-      cell_hi[d] = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
+      cell_lo[d] = states.face(d, std::int64_t(multi[d]));
+      cell_hi[d] = states.face(d, std::int64_t(multi[d]) + 1);
     }
     if (touched[cell]) {
       roles[cell] = CellRole::FixedZero;

@@ -83,9 +83,8 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
       for (std::size_t r = row(cell, 0, 0); r < row(cell + 1, 0, 0); ++r) {
         mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
         for (std::size_t d = 0; d < dims_; ++d) {
-          const double face_lo = states.lb()[d] + (double(multi[d]) - 0.5) * states.eta()[d];
-          const double face_hi = states.lb()[d] + (double(multi[d]) + 0.5) * states.eta()[d];
-          const MassInterval scale = per_dimension[d].scale_range(face_lo, face_hi);
+          const auto k = std::int64_t(multi[d]);
+          const MassInterval scale = per_dimension[d].scale_range(states.face(d, k), states.face(d, k + 1));
           const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
           const auto found = table.index[d].emplace(key, std::uint32_t(table.distinct[d].size()));
           index_[r * dims_ + d] = found.first->second;

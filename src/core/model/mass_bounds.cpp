@@ -251,10 +251,9 @@ DimensionBounds MassBounds::dimension_bounds(const Grid& states, double m_lo, do
     out.cut = {0.0, 1.0};
     return out;
   }
-  const double lb = states.lb()[dim_], eta = states.eta()[dim_];
   const auto count = static_cast<std::int64_t>(states.count(dim_));
   // Cell faces as the noise model computes them: lb + (k -+ 1/2) eta.
-  auto face = [&](std::int64_t k) { return lb + (double(k) - 0.5) * eta; };
+  auto face = [&](std::int64_t k) { return states.face(dim_, k); };
   auto mass = [&](double a, double b) { return bounds(a, b, m_lo, m_hi, s_lo, s_hi); };
   auto sum = [](const MassInterval& x, const MassInterval& y) {
     return MassInterval{std::max(0.0, round_down(x.lo + y.lo)), std::min(1.0, round_up(x.hi + y.hi))};
