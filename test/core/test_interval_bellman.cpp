@@ -22,7 +22,7 @@ constexpr double kOrthogonalSlack = 1e-12;
 
 double optimum(const std::vector<double>& lo, const std::vector<double>& hi, const std::vector<double>& values,
                Bound bound) {
-  std::vector<std::size_t> order;
+  std::vector<OutcomeSlack> order;
   return robust_expectation(lo.data(), hi.data(), values.data(), lo.size(), bound, order);
 }
 

@@ -18,33 +18,35 @@ void require(bool invariant, const char* what) {
 double robust_expectation_rounding(std::size_t count) { return double(4 * count + 4) * kUnitRoundoff; }
 
 double robust_expectation(const double* lo, const double* hi, const double* values, std::size_t count, Bound bound,
-                          std::vector<std::size_t>& order) {
+                          std::vector<OutcomeSlack>& order) {
   double sum_lo = 0.0, sum_hi = 0.0, result = 0.0;
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  if (order.size() < count) order.resize(count);
+  // Only outcomes with slack take part in the filling (the others would be given 0). Insertion
+  // sort on the outcomes themselves: rows are short (a window and two outcomes), it allocates
+  // nothing, and it is stable, so ties fill in index order whatever the other values.
+  OutcomeSlack* sorted = order.data();
+  std::size_t filled = 0;
   for (std::size_t j = 0; j < count; ++j) {
     sum_lo += lo[j];
     sum_hi += hi[j];
     result += lo[j] * values[j];
+    const double slack = hi[j] - lo[j];
+    if (!(slack > 0.0)) continue;
+    const double key = sign * values[j];
+    std::size_t k = filled++;
+    while (k > 0 && sorted[k - 1].key > key) {
+      sorted[k] = sorted[k - 1];
+      --k;
+    }
+    sorted[k] = {key, values[j], slack};
   }
   const double rounding = robust_expectation_rounding(count);
   require(sum_lo <= 1.0 + rounding && sum_hi >= 1.0 - rounding, "a row with sum lo <= 1 <= sum hi");
-  // The adversary (Lower) fills the lowest values first, the friend (Upper) the highest; stable, so
-  // that ties fill in index order whatever the other values. Rows are short (a window and two
-  // outcomes): insertion sort, which allocates nothing.
-  order.resize(count);
-  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
-  for (std::size_t j = 0; j < count; ++j) {
-    std::size_t k = j;
-    while (k > 0 && sign * values[order[k - 1]] > sign * values[j]) {
-      order[k] = order[k - 1];
-      --k;
-    }
-    order[k] = j;
-  }
   double budget = 1.0 - sum_lo;
-  for (std::size_t j : order) {
-    if (!(budget > 0.0)) break;
-    const double given = std::min(hi[j] - lo[j], budget);
-    result += given * values[j];
+  for (std::size_t k = 0; k < filled && budget > 0.0; ++k) {
+    const double given = std::min(sorted[k].slack, budget);
+    result += given * sorted[k].value;
     budget -= given;
   }
   result = bound == Bound::Lower ? result - rounding : result + rounding;
@@ -122,39 +124,44 @@ double joint_expectation(const IntervalRow& row, const double* values, Bound bou
   for (std::size_t j = 0; j < row.targets.size(); ++j) outcome_values[j] = values[row.targets[j]];
   outcome_values[row.targets.size()] = 0.0;  // leaves the grid
   outcome_values[row.targets.size() + 1] = cut_value(bound);
-  std::vector<std::size_t> order;
+  std::vector<OutcomeSlack> order;
   return robust_expectation(row.lo.data(), row.hi.data(), outcome_values.data(), row.lo.size(), bound, order);
 }
 
 namespace {
 
 // One stage of the product bound: dimension d's intervals over the values of its window line at
-// flat `offset` (the later dimensions already eliminated below it).
+// `prefix` (flat index over dimensions 0..d-1; the later dimensions already eliminated below it).
 double eliminate(const DimensionView* dimensions, std::size_t dims, const double* values, Bound bound,
-                 ProductScratch& scratch, std::size_t d, std::size_t offset) {
+                 ProductScratch& scratch, std::size_t d, std::size_t prefix) {
   std::atomic<double>* cached = nullptr;
   if (d > 0 && !scratch.caches.empty() && scratch.caches[d].table) {
     const ProductScratch::StageCache& cache = scratch.caches[d];
-    cached = &cache.table[offset / scratch.strides[d - 1] * cache.classes + cache.row_class];
+    cached = &cache.table[cache.row_class * scratch.prefixes[d] + prefix];
     const double known = cached->load(std::memory_order_relaxed);
     if (!std::isnan(known)) return known;
   }
   const DimensionView& dimension = dimensions[d];
   const std::size_t cells = dimension.count;
   ProductScratch::Stage& stage = scratch.stages[d];
-  stage.lo.resize(cells + 2);
-  stage.hi.resize(cells + 2);
-  stage.line.assign(cells + 2, 0.0);
+  if (stage.line.size() < cells + 2) {
+    stage.lo.resize(cells + 2);
+    stage.hi.resize(cells + 2);
+    stage.line.resize(cells + 2);
+  }
+  const std::size_t first = prefix * scratch.counts[d] + std::size_t(dimension.first);
   for (std::size_t j = 0; j < cells; ++j) {
     stage.lo[j] = dimension.cells[j].lo;
     stage.hi[j] = dimension.cells[j].hi;
-    const std::size_t position = offset + (std::size_t(dimension.first) + j) * scratch.strides[d];
     // An outcome that can get no mass needs no value.
-    if (stage.hi[j] > 0.0)
-      stage.line[j] = d + 1 == dims ? values[position] : eliminate(dimensions, dims, values, bound, scratch, d + 1, position);
+    if (!(stage.hi[j] > 0.0))
+      stage.line[j] = 0.0;
+    else
+      stage.line[j] = d + 1 == dims ? values[first + j] : eliminate(dimensions, dims, values, bound, scratch, d + 1, first + j);
   }
   stage.lo[cells] = dimension.leave.lo;  // worth 0
   stage.hi[cells] = dimension.leave.hi;
+  stage.line[cells] = 0.0;
   stage.lo[cells + 1] = dimension.cut.lo;
   stage.hi[cells + 1] = dimension.cut.hi;
   stage.line[cells + 1] = cut_value(bound);
@@ -171,14 +178,16 @@ double product_expectation(const Grid& states, const DimensionView* dimensions, 
                            ProductScratch& scratch) {
   const std::size_t dims = states.dims();
   require(dims > 0, "a state grid with dimensions");
-  if (scratch.strides.size() != dims) {
+  if (scratch.counts.size() != dims) {
     scratch.stages.resize(dims);
-    scratch.strides.resize(dims);
-  }
-  std::size_t stride = 1;
-  for (std::size_t d = dims; d-- > 0;) {
-    scratch.strides[d] = stride;
-    stride *= states.count(d);
+    scratch.counts.resize(dims);
+    scratch.prefixes.resize(dims);
+    std::size_t prefix = 1;
+    for (std::size_t d = 0; d < dims; ++d) {
+      scratch.counts[d] = states.count(d);
+      scratch.prefixes[d] = prefix;
+      prefix *= states.count(d);
+    }
   }
   return eliminate(dimensions, dims, values, bound, scratch, 0, 0);
 }

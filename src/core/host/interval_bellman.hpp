@@ -23,14 +23,20 @@ namespace amytiss::detail {
 
 enum class Bound { Lower, Upper };
 
+/// An outcome that can take more than its lower bound, as robust_expectation() orders them.
+struct OutcomeSlack {
+  double key;    ///< value (Lower) or -value (Upper): filled in increasing order of key
+  double value;  ///< in [0, 1]
+  double slack;  ///< hi - lo > 0
+};
 /// The O-maximisation: min (Lower) or max (Upper) of sum_j p_j values_j over lo <= p <= hi,
 /// sum_j p_j = 1, j < count. Starts from lo and gives the budget 1 - sum lo to the outcomes in
-/// increasing (Lower) or decreasing (Upper) order of value, each at most hi - lo. Values lie in
-/// [0, 1]; the row must be feasible (sum lo <= 1 <= sum hi up to rounding; std::logic_error
-/// otherwise). The result is moved outward by the arithmetic's error bound and clipped to [0, 1].
-/// `order` is scratch space.
+/// increasing (Lower) or decreasing (Upper) order of value (ties in index order), each at most
+/// hi - lo. Values lie in [0, 1]; the row must be feasible (sum lo <= 1 <= sum hi up to rounding;
+/// std::logic_error otherwise). The result is moved outward by the arithmetic's error bound and
+/// clipped to [0, 1]. `order` is scratch space.
 double robust_expectation(const double* lo, const double* hi, const double* values, std::size_t count, Bound bound,
-                          std::vector<std::size_t>& order);
+                          std::vector<OutcomeSlack>& order);
 /// The error bound robust_expectation() allows for, for `count` outcomes: (4 count + 4) u.
 double robust_expectation_rounding(std::size_t count);
 
@@ -75,13 +81,14 @@ struct ProductScratch {
     std::vector<double> lo, hi, line;
   };
   std::vector<Stage> stages;           ///< one per dimension
-  std::vector<std::size_t> strides;    ///< flat strides of the state grid
-  std::vector<std::size_t> order;      ///< robust_expectation()'s
+  std::vector<std::size_t> counts;     ///< cells of the state grid per dimension
+  std::vector<std::size_t> prefixes;   ///< prefixes[d]: cells of dimensions 0..d-1 (1 for d = 0)
+  std::vector<OutcomeSlack> order;     ///< robust_expectation()'s
   std::vector<DimensionView> views;    ///< for callers that gather a row's views
   /// Optional, for rows that share the bounds of dimensions d..dims-1 (1 <= d < dims): stage d's
   /// result on the window line at prefix p (flat index over dimensions 0..d-1) is kept at
-  /// table[p * classes + row_class]; NaN: not computed yet. A cache belongs to one `values`
-  /// vector and one bound; the caller sets row_class for each row.
+  /// table[row_class * prefixes[d] + p] (one class's lines side by side); NaN: not computed yet.
+  /// A cache belongs to one `values` vector and one bound; the caller sets row_class for each row.
   struct StageCache {
     std::atomic<double>* table = nullptr;  ///< null: stage d is not cached
     std::size_t classes = 0;

@@ -11,6 +11,10 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
   stage_caches_.resize(dims);
   stage_cache_entries_.assign(dims, 0);
   if (set_ != AmbiguitySet::Product) return;
+  if (ProductSweep::pays(a_.states, rows_, a_.triples())) {
+    sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_);
+    return;
+  }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
   // when it has fewer entries than the lines the rows would compute (kLinesPerRow per row and
   // stage at least) and fits the budget; clearing it at every step is then cheap.
@@ -40,6 +44,7 @@ void IntervalStep::use_stage_caches(ProductScratch& scratch) const {
 }
 
 double IntervalStep::expectation(std::size_t row, const double* in, ProductScratch& scratch) const {
+  if (sweep_) return sweep_->expectation(row);
   DimensionView* views = scratch.views.data();
   rows_.dimensions(row, views);
   for (std::size_t d = 1; d < scratch.caches.size(); ++d)
@@ -57,6 +62,7 @@ double IntervalStep::worst_case(std::size_t cell, std::size_t input, const doubl
 
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   reset_stage_caches();
+  if (sweep_) sweep_->prepare(in);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);
@@ -81,6 +87,7 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
 
 void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* controller) {
   reset_stage_caches();
+  if (sweep_) sweep_->prepare(in);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);

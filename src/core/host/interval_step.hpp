@@ -11,6 +11,7 @@
 #include "amytiss/abstraction.hpp"
 #include "host/bellman_step.hpp"
 #include "host/interval_bellman.hpp"
+#include "host/product_sweep.hpp"
 #include "host/robust_reference.hpp"
 #include "host/row_bounds.hpp"
 
@@ -46,6 +47,8 @@ class IntervalStep : public BellmanStep {
   // (ProductScratch::caches); per dimension, empty where it would not pay.
   std::vector<std::unique_ptr<std::atomic<double>[]>> stage_caches_;
   std::vector<std::size_t> stage_cache_entries_;
+  // The product set over whole tables where it pays (host/product_sweep.hpp); then no caches.
+  std::unique_ptr<ProductSweep> sweep_;
 };
 
 }  // namespace amytiss::detail

@@ -29,6 +29,20 @@ void parallel_for(std::size_t count, unsigned threads,
   if (failure) std::rethrow_exception(failure);
 }
 
+std::vector<std::vector<std::size_t>> bounds_reads(const Abstraction& a) {
+  const auto uses = a.dynamics->dependencies();
+  if (!uses) return {};
+  std::vector<std::vector<std::size_t>> reads;
+  for (std::size_t d = 0; d < a.states.dims(); ++d) {
+    std::vector<std::size_t> dims = (*uses)[d].states;
+    dims.push_back(d);  // the noise's scale may depend on it
+    std::sort(dims.begin(), dims.end());
+    dims.erase(std::unique(dims.begin(), dims.end()), dims.end());
+    reads.push_back(dims);
+  }
+  return reads;
+}
+
 unsigned host_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 namespace {
@@ -61,11 +75,47 @@ struct WorkerTables {
 
 }  // namespace
 
+// Per dimension, the rows of one worker that share a mean box and scale: key = the cell's index
+// over the dimensions read, times the rows per cell, plus the row within the cell.
+class SharedBounds {
+ public:
+  static constexpr std::uint32_t kUnknown = ~std::uint32_t(0);
+  // At most this many keys per dimension; beyond, the dimension shares nothing.
+  static constexpr std::size_t kMaxKeys = std::size_t(1) << 22;
+
+  SharedBounds(const Grid& states, std::size_t rows_per_cell, const std::vector<std::vector<std::size_t>>& reads)
+      : rows_per_cell_(rows_per_cell), reads_(reads), known_(states.dims()) {
+    for (std::size_t d = 0; d < reads.size(); ++d) {
+      std::size_t keys = rows_per_cell;
+      for (std::size_t j : reads[d]) keys *= states.count(j);
+      if (reads[d].size() < states.dims() && keys <= kMaxKeys) known_[d].assign(keys, kUnknown);
+    }
+  }
+  // The cell's part of each dimension's key.
+  void enter(const Grid& states, const std::size_t* multi) {
+    cell_key_.assign(known_.size(), 0);
+    for (std::size_t d = 0; d < known_.size(); ++d) {
+      if (known_[d].empty()) continue;
+      for (std::size_t j : reads_[d]) cell_key_[d] = cell_key_[d] * states.count(j) + multi[j];
+    }
+  }
+  std::uint32_t* slot(std::size_t d, std::size_t row_in_cell) {
+    return known_[d].empty() ? nullptr : &known_[d][cell_key_[d] * rows_per_cell_ + row_in_cell];
+  }
+
+ private:
+  std::size_t rows_per_cell_;
+  const std::vector<std::vector<std::size_t>>& reads_;
+  std::vector<std::vector<std::uint32_t>> known_;
+  std::vector<std::size_t> cell_key_;
+};
+
 RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturbances, const NoiseModel& noise,
-                     const MeanBox& mean_box, const std::vector<bool>& needed, unsigned threads)
+                     const MeanBox& mean_box, const std::vector<bool>& needed, unsigned threads,
+                     const std::vector<std::vector<std::size_t>>& reads)
     : dims_(states.dims()), inputs_(inputs.size()), disturbances_(disturbances.size()) {
-  const std::size_t cells = states.size();
-  index_.assign(cells * inputs_ * disturbances_ * dims_, 0);
+  const std::size_t cells = states.size(), rows_per_cell = inputs_ * disturbances_;
+  index_.assign(cells * rows_per_cell * dims_, 0);
   threads = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, cells)));
   std::vector<MassBounds> per_dimension;
   for (std::size_t d = 0; d < dims_; ++d) per_dimension.emplace_back(noise, d);
@@ -75,19 +125,33 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
     table.distinct.resize(dims_);
     table.pool_offset.resize(dims_);
     table.index.resize(dims_);
+    SharedBounds shared(states, rows_per_cell, reads);
     std::vector<double> lo(dims_), hi(dims_);
     std::vector<std::size_t> multi(dims_);
+    std::vector<std::uint32_t*> slots(dims_);
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
       if (!needed[cell]) continue;
       states.multi_index(cell, multi.data());
+      shared.enter(states, multi.data());
       for (std::size_t r = row(cell, 0, 0); r < row(cell + 1, 0, 0); ++r) {
+        bool known = true;
+        for (std::size_t d = 0; d < dims_; ++d) {
+          slots[d] = shared.slot(d, r - row(cell, 0, 0));
+          if (slots[d] && *slots[d] != SharedBounds::kUnknown)
+            index_[r * dims_ + d] = *slots[d];
+          else
+            known = false;
+        }
+        if (known) continue;
         mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
         for (std::size_t d = 0; d < dims_; ++d) {
+          if (slots[d] && *slots[d] != SharedBounds::kUnknown) continue;
           const auto k = std::int64_t(multi[d]);
           const MassInterval scale = per_dimension[d].scale_range(states.face(d, k), states.face(d, k + 1));
           const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
           const auto found = table.index[d].emplace(key, std::uint32_t(table.distinct[d].size()));
           index_[r * dims_ + d] = found.first->second;
+          if (slots[d]) *slots[d] = found.first->second;
           if (!found.second) continue;
           const DimensionBounds bounds = per_dimension[d].dimension_bounds(states, lo[d], hi[d], scale.lo, scale.hi);
           table.distinct[d].push_back({bounds.first, bounds.cells.size(), nullptr, bounds.leave, bounds.cut});
@@ -133,6 +197,7 @@ void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {
   // being its bounds' index.
   suffix_class_.assign(index_.size(), 0);
   suffix_classes_.assign(dims_, 0);
+  suffix_parts_.assign(dims_, {});
   const std::size_t rows_per_cell = inputs_ * disturbances_;
   for (std::size_t d = dims_; d-- > 1;) {
     std::unordered_map<std::uint64_t, std::uint32_t> classes;
@@ -141,7 +206,9 @@ void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {
       for (std::size_t r = cell * rows_per_cell; r < (cell + 1) * rows_per_cell; ++r) {
         const std::uint64_t next = d + 1 < dims_ ? suffix_class_[r * dims_ + d + 1] : 0;
         const std::uint64_t pair = (next << 32) | index_[r * dims_ + d];
-        suffix_class_[r * dims_ + d] = classes.emplace(pair, std::uint32_t(classes.size())).first->second;
+        const auto found = classes.emplace(pair, std::uint32_t(classes.size()));
+        suffix_class_[r * dims_ + d] = found.first->second;
+        if (found.second) suffix_parts_[d].push_back({index_[r * dims_ + d], std::uint32_t(next)});
       }
     }
     suffix_classes_[d] = classes.size();

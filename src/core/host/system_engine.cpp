@@ -22,7 +22,8 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
     needed[x] = lower_roles[x] == CellRole::Free || upper_roles[x] == CellRole::Free;
   const ImageEnclosure enclosure(a.config);
   const RowBounds rows(a.states, a.inputs, a.disturbances, *a.noise,
-                       enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, threads);
+                       enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, threads,
+                       bounds_reads(a));
   const double construction_seconds = seconds_since(construction_start);
   reporter.phase(PhaseKind::Construction, "interval bounds", construction_seconds,
                  double(a.pairs()) / std::max(construction_seconds, 1e-9));

@@ -1,0 +1,166 @@
+#include "host/product_sweep.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+
+namespace amytiss::detail {
+namespace {
+
+void require(bool invariant, const char* what) {
+  if (!invariant) throw std::logic_error(std::string("product sweep: ") + what);
+}
+
+// A scan is cheaper than robust_expectation()'s sort while the line is at most this many times
+// longer than the window.
+constexpr std::size_t kScanLengthPerOutcome = 4;
+// Lines up to this long visit only the window's cells (a bit per rank).
+constexpr std::size_t kMaskBits = 256;
+
+}  // namespace
+
+double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                           std::size_t length, const DimensionView& window, Bound bound) {
+  const std::size_t count = window.count, first = std::size_t(window.first);
+  require(window.first >= 0 && first + count <= length, "a window inside its line");
+  const MassInterval* cells = window.cells;
+  const double cut = cut_value(bound);
+  // The sums in robust_expectation()'s order: the window's cells, then leave, then cut.
+  double sum_lo = 0.0, sum_hi = 0.0, result = 0.0;
+  for (std::size_t j = 0; j < count; ++j) {
+    sum_lo += cells[j].lo;
+    sum_hi += cells[j].hi;
+    result += cells[j].lo * line[first + j];
+  }
+  sum_lo += window.leave.lo;
+  sum_hi += window.leave.hi;
+  result += window.leave.lo * 0.0;
+  sum_lo += window.cut.lo;
+  sum_hi += window.cut.hi;
+  result += window.cut.lo * cut;
+  const double rounding = robust_expectation_rounding(count + 2);
+  require(sum_lo <= 1.0 + rounding && sum_hi >= 1.0 - rounding, "a row with sum lo <= 1 <= sum hi");
+  // Leave and cut come after the line's cells of the same value (their index is larger).
+  struct Extra {
+    double key, value, slack;
+  };
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  const Extra leave{0.0, 0.0, window.leave.hi - window.leave.lo}, cut_mass{sign * cut, cut, window.cut.hi - window.cut.lo};
+  const Extra extras[2] = {bound == Bound::Lower ? leave : cut_mass, bound == Bound::Lower ? cut_mass : leave};
+  std::size_t next_extra = 0;
+  double budget = 1.0 - sum_lo;
+  auto give = [&](double value, double slack) {
+    // Outcomes without slack take no part (robust_expectation() skips them); branch-free.
+    const double given = slack > 0.0 ? std::min(slack, budget) : 0.0;
+    result += given * value;
+    budget -= given;
+  };
+  auto give_cell = [&](std::size_t position) {
+    const double value = line[position];
+    while (next_extra < 2 && extras[next_extra].key < sign * value && budget > 0.0) {
+      give(extras[next_extra].value, extras[next_extra].slack);
+      ++next_extra;
+    }
+    const std::size_t k = position - first;  // wraps above count when before the window
+    const std::size_t safe = k < count ? k : 0;
+    if (budget > 0.0) give(value, k < count ? cells[safe].hi - cells[safe].lo : 0.0);
+  };
+  if (length <= kMaskBits) {
+    // The window's cells with slack as bits at their ranks: visiting the set bits in increasing
+    // order visits exactly them, in filling order.
+    std::uint64_t mask[kMaskBits / 64] = {};
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::uint32_t r = rank[first + j];
+      mask[r / 64] |= std::uint64_t(cells[j].hi - cells[j].lo > 0.0) << (r % 64);
+    }
+    for (std::size_t word = 0; word * 64 < length && budget > 0.0; ++word)
+      for (std::uint64_t bits = mask[word]; bits && budget > 0.0; bits &= bits - 1)
+        give_cell(order[word * 64 + std::size_t(__builtin_ctzll(bits))]);
+  } else {
+    for (std::size_t r = 0; r < length && budget > 0.0; ++r) give_cell(order[r]);
+  }
+  for (; next_extra < 2 && budget > 0.0; ++next_extra) give(extras[next_extra].value, extras[next_extra].slack);
+  result = bound == Bound::Lower ? result - rounding : result + rounding;
+  return std::clamp(result, 0.0, 1.0);
+}
+
+bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
+  constexpr std::size_t kLinesPerRow = 16;
+  std::size_t entries = 0, prefixes = 1;
+  for (std::size_t d = 0; d < states.dims(); ++d) {
+    std::size_t window_cells = 0;
+    for (std::uint32_t b = 0; b < rows.distinct_bounds(d); ++b) window_cells += rows.distinct(d, b).count + 2;
+    if (states.count(d) * rows.distinct_bounds(d) > kScanLengthPerOutcome * window_cells) return false;
+    if (d == 0) continue;
+    prefixes *= states.count(d - 1);
+    const std::size_t stage = prefixes * rows.suffix_classes(d);
+    if (stage > kLinesPerRow * row_count) return false;
+    entries += stage;
+  }
+  return entries <= kMaxTableEntries;
+}
+
+ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads)
+    : states_(states), rows_(rows), bound_(bound), threads_(threads) {
+  const std::size_t dims = states.dims();
+  prefixes_.assign(dims, 1);
+  tables_.resize(dims);
+  for (std::size_t d = 1; d < dims; ++d) {
+    prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
+    tables_[d].resize(prefixes_[d] * rows.suffix_classes(d));
+  }
+}
+
+void ProductSweep::sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const {
+  sorted.order.resize(count * length);
+  sorted.rank.resize(count * length);
+  const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
+  parallel_for(count, threads_, [&](unsigned, std::size_t first, std::size_t last) {
+    for (std::size_t line = first; line < last; ++line) {
+      const double* values = lines + line * length;
+      std::uint32_t* positions = sorted.order.data() + line * length;
+      std::iota(positions, positions + length, 0u);
+      std::stable_sort(positions, positions + length,
+                       [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; });
+      std::uint32_t* ranks = sorted.rank.data() + line * length;
+      for (std::size_t r = 0; r < length; ++r) ranks[positions[r]] = std::uint32_t(r);
+    }
+  });
+}
+
+void ProductSweep::run_stage(std::size_t d, const double* source) {
+  const std::size_t length = states_.count(d), prefixes = prefixes_[d];
+  const std::size_t source_classes = d + 1 == states_.dims() ? 1 : rows_.suffix_classes(d + 1);
+  // Line (next, p) of the source: the values at prefix p * length + k of class next.
+  sort_lines(source, source_classes * prefixes, length, source_order_);
+  double* table = tables_[d].data();
+  parallel_for(rows_.suffix_classes(d), threads_, [&](unsigned, std::size_t first, std::size_t last) {
+    for (std::size_t suffix_class = first; suffix_class < last; ++suffix_class) {
+      const RowBounds::SuffixParts parts = rows_.suffix_parts(d, std::uint32_t(suffix_class));
+      const DimensionView& window = rows_.distinct(d, parts.bounds);
+      for (std::size_t p = 0; p < prefixes; ++p) {
+        const std::size_t line = (std::size_t(parts.next) * prefixes + p) * length;
+        table[suffix_class * prefixes + p] =
+            ordered_expectation(source + line, source_order_.order.data() + line, source_order_.rank.data() + line,
+                                length, window, bound_);
+      }
+    }
+  });
+}
+
+void ProductSweep::prepare(const double* values) {
+  const std::size_t dims = states_.dims();
+  for (std::size_t d = dims; d-- > 1;) run_stage(d, d + 1 == dims ? values : tables_[d + 1].data());
+  stage0_lines_ = dims == 1 ? values : tables_[1].data();
+  sort_lines(stage0_lines_, dims == 1 ? 1 : rows_.suffix_classes(1), states_.count(0), stage0_order_);
+}
+
+double ProductSweep::expectation(std::size_t row) const {
+  const std::size_t length = states_.count(0);
+  const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
+  return ordered_expectation(stage0_lines_ + line, stage0_order_.order.data() + line,
+                             stage0_order_.rank.data() + line, length, rows_.distinct(0, rows_.bounds_index(row, 0)),
+                             bound_);
+}
+
+}  // namespace amytiss::detail

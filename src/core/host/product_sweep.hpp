@@ -1,0 +1,63 @@
+#pragma once
+// The product (orthogonally decoupled) bound of every row of an interval MDP, one dimension per
+// stage over whole tables, like the factored sweep of the abstraction (docs/engine.md): stage d
+// (from the last dimension down to 1) applies dimension d's intervals of every suffix class
+// (host/row_bounds.hpp) to every line of stage d + 1's table; stage 0 is done per row. Each line
+// of values is sorted once for all the intervals applied to it, so that an O-maximisation is a
+// scan in sorted order instead of a sort. Same results, bit for bit, as product_expectation()
+// with the stage caches of host/interval_step.hpp.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "amytiss/grid.hpp"
+#include "host/interval_bellman.hpp"
+#include "host/row_bounds.hpp"
+
+namespace amytiss::detail {
+
+class ProductSweep {
+ public:
+  /// At most this many table entries (a double and a 32-bit position each).
+  static constexpr std::size_t kMaxTableEntries = std::size_t(1) << 24;
+  /// Whether the sweep pays for these rows (`row_count` of them): its tables fit
+  /// kMaxTableEntries, no stage computes more lines than 16 per row, and every dimension's line
+  /// is at most 4 times as long as its average window (a scan reads the whole line). Otherwise
+  /// product_expectation() row by row is the cheaper way to the same results.
+  static bool pays(const Grid& states, const RowBounds& rows, std::size_t row_count);
+  ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads);
+  /// Stages dims-1..1 over `values` (one per state cell, flat) and the sort order of stage 0's
+  /// lines.
+  void prepare(const double* values);
+  /// Stage 0 of `row` over the values of the last prepare(): the row's product bound.
+  double expectation(std::size_t row) const;
+
+ private:
+  // Stage d's table, [suffix class][prefix], from its source's lines.
+  void run_stage(std::size_t d, const double* source);
+  // Sort order of every line of `count` lines of `length` values: order[line * length + r] is the
+  // position of the r-th value of the line in the bound's filling order (stable), rank the inverse.
+  struct LineOrder {
+    std::vector<std::uint32_t> order, rank;
+  };
+  void sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const;
+  const Grid& states_;
+  const RowBounds& rows_;
+  Bound bound_;
+  unsigned threads_;
+  std::vector<std::size_t> prefixes_;        // cells of dimensions 0..d-1
+  std::vector<std::vector<double>> tables_;  // per dimension d >= 1
+  LineOrder source_order_;  // the current stage's source lines' order
+  LineOrder stage0_order_;  // stage 0's lines' order
+  const double* stage0_lines_ = nullptr;
+};
+
+/// One O-maximisation of robust_expectation() over a window of a line whose filling order is
+/// known: `line` holds the values of the dimension's grid cells, `order` their positions in the
+/// bound's filling order and `rank` each position's place in it, `window` the intervals (cells
+/// first.. of the line, leave worth 0, cut worth cut_value(bound)). The result is
+/// robust_expectation()'s, bit for bit.
+double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                           std::size_t length, const DimensionView& window, Bound bound);
+
+}  // namespace amytiss::detail

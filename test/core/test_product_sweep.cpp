@@ -1,0 +1,179 @@
+// The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
+// known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
+// ties, the leave and cut outcomes); the sweep gives product_expectation()'s row by row; rows
+// that share a mean box through what the map reads get the bounds they would compute themselves.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "amytiss/enclosure.hpp"
+#include "host/enclosure_mean_box.hpp"
+#include "host/product_sweep.hpp"
+#include "host/row_bounds.hpp"
+#include "test_support.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+using namespace amytiss::test_support;
+
+constexpr unsigned kSeed = 20261202;
+constexpr int kRandomRows = 4000;
+
+// A random feasible window of `count` cells at `first` with leave and cut, values drawn from a few
+// levels (ties) including 0 and 1.
+struct RandomRow {
+  std::vector<MassInterval> cells;
+  DimensionView window;
+};
+
+RandomRow random_row(std::mt19937& random, std::size_t length) {
+  std::uniform_int_distribution<std::size_t> count_of(1, std::min<std::size_t>(length, 30));
+  RandomRow row;
+  const std::size_t count = count_of(random);
+  const std::size_t first = std::uniform_int_distribution<std::size_t>(0, length - count)(random);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> centre(count + 2);
+  for (double& mass : centre) mass = unit(random) < 0.2 ? 0.0 : unit(random);
+  centre[count] += 1e-3;  // some mass somewhere
+  const double total = std::accumulate(centre.begin(), centre.end(), 0.0);
+  std::vector<MassInterval> all;
+  for (double mass : centre) {
+    const double p = mass / total, width = unit(random) < 0.3 ? 0.0 : 0.2 * unit(random) * p + 1e-3 * unit(random);
+    all.push_back({std::max(0.0, p - width), std::min(1.0, p + width)});
+  }
+  row.cells.assign(all.begin(), all.begin() + std::ptrdiff_t(count));
+  row.window = {std::int64_t(first), count, nullptr, all[count], all[count + 1]};
+  return row;
+}
+
+std::vector<double> random_line(std::mt19937& random, std::size_t length) {
+  std::uniform_int_distribution<int> level(0, 6);
+  std::vector<double> line(length);
+  for (double& value : line) value = level(random) / 6.0;
+  return line;
+}
+
+// The line's filling order for `bound` (stable) and its inverse.
+void order_of(const std::vector<double>& line, Bound bound, std::vector<std::uint32_t>& order,
+              std::vector<std::uint32_t>& rank) {
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  order.resize(line.size());
+  rank.resize(line.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return sign * line[a] < sign * line[b]; });
+  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r]] = std::uint32_t(r);
+}
+
+double sorted_expectation(const std::vector<double>& line, const RandomRow& row, Bound bound) {
+  std::vector<double> lo, hi, values;
+  for (std::size_t j = 0; j < row.cells.size(); ++j) {
+    lo.push_back(row.cells[j].lo);
+    hi.push_back(row.cells[j].hi);
+    values.push_back(line[std::size_t(row.window.first) + j]);
+  }
+  lo.push_back(row.window.leave.lo);
+  hi.push_back(row.window.leave.hi);
+  values.push_back(0.0);
+  lo.push_back(row.window.cut.lo);
+  hi.push_back(row.window.cut.hi);
+  values.push_back(cut_value(bound));
+  std::vector<OutcomeSlack> scratch;
+  return robust_expectation(lo.data(), hi.data(), values.data(), lo.size(), bound, scratch);
+}
+
+TEST(ProductSweep, OrderedExpectationIsTheSortedOneBitForBit) {
+  std::mt19937 random(kSeed);
+  // 41: one mask word; 200: several words; 300: the full scan.
+  for (std::size_t length : {std::size_t(1), std::size_t(41), std::size_t(200), std::size_t(300)}) {
+    for (int trial = 0; trial < kRandomRows; ++trial) {
+      const std::vector<double> line = random_line(random, length);
+      RandomRow row = random_row(random, length);
+      row.window.cells = row.cells.data();
+      for (Bound bound : {Bound::Lower, Bound::Upper}) {
+        std::vector<std::uint32_t> order, rank;
+        order_of(line, bound, order, rank);
+        EXPECT_EQ(ordered_expectation(line.data(), order.data(), rank.data(), length, row.window, bound),
+                  sorted_expectation(line, row, bound))
+            << "length " << length << " trial " << trial;
+      }
+    }
+  }
+}
+
+std::string system_3d_yaml(const std::string& integrator = "") {
+  return "name: sweep_3d\n" + integrator +
+         "states: {lb: [-2, -2, -1], ub: [2, 2, 1], eta: [0.25, 0.25, 0.25]}\n"
+         "inputs: {lb: [-0.5], ub: [0.5], eta: [0.25]}\n"
+         "disturbances: {lb: [-0.1], ub: [0.1], eta: [0.2]}\n"
+         "dynamics: [\"x0 + 0.5*x1\", \"0.9*x1 + 0.2*sin(x0) + u0 + w0\", \"0.8*x2 + 0.1*x0*x1\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.04, 0.04, 0.02],\n"
+         "        truncation: cutting_probability, cutting_probability: 1.0e-4}\n"
+         "spec: {type: safety, horizon: 2}\n"
+         "guarantee: system\n";
+}
+
+RowBounds bounds_of(const Abstraction& a, const ImageEnclosure& enclosure,
+                    const std::vector<std::vector<std::size_t>>& reads) {
+  const std::vector<bool> needed(a.states.size(), true);
+  return RowBounds(a.states, a.inputs, a.disturbances, *a.noise,
+                   enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, 2, reads);
+}
+
+TEST(ProductSweep, SweepGivesTheRowByRowProductBound) {
+  const Abstraction a = from_yaml(system_3d_yaml());
+  const ImageEnclosure enclosure(a.config);
+  const RowBounds rows = bounds_of(a, enclosure, bounds_reads(a));
+  std::mt19937 random(kSeed);
+  const std::vector<double> values = random_line(random, a.states.size());
+  std::vector<DimensionView> views(a.states.dims());
+  for (Bound bound : {Bound::Lower, Bound::Upper}) {
+    ProductSweep sweep(a.states, rows, bound, 2);
+    sweep.prepare(values.data());
+    ProductScratch scratch;
+    for (std::size_t row = 0; row < a.triples(); ++row) {
+      rows.dimensions(row, views.data());
+      ASSERT_EQ(sweep.expectation(row), product_expectation(a.states, views.data(), values.data(), bound, scratch))
+          << "row " << row;
+    }
+  }
+}
+
+void expect_shared_bounds_are_own(const std::string& yaml, const std::vector<std::vector<std::size_t>>& expected_reads) {
+  const Abstraction a = from_yaml(yaml);
+  const ImageEnclosure enclosure(a.config);
+  const std::vector<std::vector<std::size_t>> reads = bounds_reads(a);
+  ASSERT_EQ(reads, expected_reads);
+  const RowBounds shared = bounds_of(a, enclosure, reads), own = bounds_of(a, enclosure, {});
+  std::vector<DimensionView> mine(a.states.dims()), theirs(a.states.dims());
+  for (std::size_t row = 0; row < a.triples(); ++row) {
+    shared.dimensions(row, mine.data());
+    own.dimensions(row, theirs.data());
+    for (std::size_t d = 0; d < a.states.dims(); ++d) {
+      ASSERT_EQ(mine[d].first, theirs[d].first) << "row " << row << " dimension " << d;
+      ASSERT_EQ(mine[d].count, theirs[d].count) << "row " << row << " dimension " << d;
+      for (std::size_t k = 0; k < mine[d].count; ++k) {
+        ASSERT_EQ(mine[d].cells[k].lo, theirs[d].cells[k].lo) << "row " << row << " dimension " << d;
+        ASSERT_EQ(mine[d].cells[k].hi, theirs[d].cells[k].hi) << "row " << row << " dimension " << d;
+      }
+      ASSERT_EQ(mine[d].leave.lo, theirs[d].leave.lo);
+      ASSERT_EQ(mine[d].leave.hi, theirs[d].leave.hi);
+      ASSERT_EQ(mine[d].cut.lo, theirs[d].cut.lo);
+      ASSERT_EQ(mine[d].cut.hi, theirs[d].cut.hi);
+    }
+  }
+}
+
+TEST(ProductSweep, SharedMeanBoxesGiveEveryRowItsOwnBounds) {
+  // The map itself: x2 is read by no other coordinate.
+  expect_shared_bounds_are_own(system_3d_yaml(), {{0, 1}, {0, 1}, {0, 1, 2}});
+  // The same expressions as a vector field under RK4: coordinates read the closure.
+  expect_shared_bounds_are_own(system_3d_yaml("integrator: {method: rk4, substeps: 2, tau: 0.1}\n"),
+                               {{0, 1}, {0, 1}, {0, 1, 2}});
+}
+
+}  // namespace
+}  // namespace amytiss::detail
