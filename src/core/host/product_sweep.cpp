@@ -85,7 +85,7 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
 }
 
 bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
-  constexpr std::size_t kLinesPerRow = 16;
+  constexpr std::size_t kLinesPerRow = 64;
   std::size_t entries = 0, prefixes = 1;
   for (std::size_t d = 0; d < states.dims(); ++d) {
     std::size_t window_cells = 0;

@@ -21,7 +21,7 @@ class ProductSweep {
   /// At most this many table entries (a double and a 32-bit position each).
   static constexpr std::size_t kMaxTableEntries = std::size_t(1) << 24;
   /// Whether the sweep pays for these rows (`row_count` of them): its tables fit
-  /// kMaxTableEntries, no stage computes more lines than 16 per row, and every dimension's line
+  /// kMaxTableEntries, no stage computes more lines than 64 per row, and every dimension's line
   /// is at most 4 times as long as its average window (a scan reads the whole line). Otherwise
   /// product_expectation() row by row is the cheaper way to the same results.
   static bool pays(const Grid& states, const RowBounds& rows, std::size_t row_count);
