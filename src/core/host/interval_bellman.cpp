@@ -15,8 +15,6 @@ void require(bool invariant, const char* what) {
 
 }  // namespace
 
-double robust_expectation_rounding(std::size_t count) { return double(4 * count + 4) * kUnitRoundoff; }
-
 double robust_expectation(const double* lo, const double* hi, const double* values, std::size_t count, Bound bound,
                           std::vector<OutcomeSlack>& order) {
   double sum_lo = 0.0, sum_hi = 0.0, result = 0.0;

@@ -38,7 +38,7 @@ struct OutcomeSlack {
 double robust_expectation(const double* lo, const double* hi, const double* values, std::size_t count, Bound bound,
                           std::vector<OutcomeSlack>& order);
 /// The error bound robust_expectation() allows for, for `count` outcomes: (4 count + 4) u.
-double robust_expectation_rounding(std::size_t count);
+inline double robust_expectation_rounding(std::size_t count) { return double(4 * count + 4) * kUnitRoundoff; }
 
 /// Value of the cut mass: 0 for the lower bound, 1 for the upper.
 inline double cut_value(Bound bound) { return bound == Bound::Upper ? 1.0 : 0.0; }

@@ -19,27 +19,44 @@ constexpr std::size_t kMaskBits = 256;
 
 }  // namespace
 
+WindowSums window_sums(const DimensionView& window) {
+  // robust_expectation()'s order: the window's cells, then leave, then cut.
+  WindowSums sums;
+  for (std::size_t j = 0; j < window.count; ++j) {
+    sums.lo += window.cells[j].lo;
+    sums.hi += window.cells[j].hi;
+  }
+  sums.lo += window.leave.lo;
+  sums.hi += window.leave.hi;
+  sums.lo += window.cut.lo;
+  sums.hi += window.cut.hi;
+  const double rounding = robust_expectation_rounding(window.count + 2);
+  require(sums.lo <= 1.0 + rounding && sums.hi >= 1.0 - rounding, "a row with sum lo <= 1 <= sum hi");
+  return sums;
+}
+
 double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                           std::size_t length, const DimensionView& window, Bound bound) {
+                           std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound) {
   const std::size_t count = window.count, first = std::size_t(window.first);
   require(window.first >= 0 && first + count <= length, "a window inside its line");
   const MassInterval* cells = window.cells;
   const double cut = cut_value(bound);
-  // The sums in robust_expectation()'s order: the window's cells, then leave, then cut.
-  double sum_lo = 0.0, sum_hi = 0.0, result = 0.0;
+  // The expectation at the lower bounds in robust_expectation()'s order. Lines up to kMaskBits
+  // long also mark the window's cells with slack as bits at their ranks: visiting the set bits in
+  // increasing order visits exactly them, in filling order.
+  const bool masked = length <= kMaskBits;
+  std::uint64_t mask[kMaskBits / 64] = {};
+  double result = 0.0;
   for (std::size_t j = 0; j < count; ++j) {
-    sum_lo += cells[j].lo;
-    sum_hi += cells[j].hi;
     result += cells[j].lo * line[first + j];
+    if (masked) {
+      const std::uint32_t r = rank[first + j];
+      mask[r / 64] |= std::uint64_t(cells[j].hi - cells[j].lo > 0.0) << (r % 64);
+    }
   }
-  sum_lo += window.leave.lo;
-  sum_hi += window.leave.hi;
   result += window.leave.lo * 0.0;
-  sum_lo += window.cut.lo;
-  sum_hi += window.cut.hi;
   result += window.cut.lo * cut;
   const double rounding = robust_expectation_rounding(count + 2);
-  require(sum_lo <= 1.0 + rounding && sum_hi >= 1.0 - rounding, "a row with sum lo <= 1 <= sum hi");
   // Leave and cut come after the line's cells of the same value (their index is larger).
   struct Extra {
     double key, value, slack;
@@ -48,36 +65,38 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
   const Extra leave{0.0, 0.0, window.leave.hi - window.leave.lo}, cut_mass{sign * cut, cut, window.cut.hi - window.cut.lo};
   const Extra extras[2] = {bound == Bound::Lower ? leave : cut_mass, bound == Bound::Lower ? cut_mass : leave};
   std::size_t next_extra = 0;
-  double budget = 1.0 - sum_lo;
+  double budget = 1.0 - sums.lo;
+  // An outcome with slack takes min(slack, budget); one without takes no part, as in
+  // robust_expectation().
   auto give = [&](double value, double slack) {
-    // Outcomes without slack take no part (robust_expectation() skips them); branch-free.
     const double given = slack > 0.0 ? std::min(slack, budget) : 0.0;
     result += given * value;
     budget -= given;
   };
-  auto give_cell = [&](std::size_t position) {
-    const double value = line[position];
-    while (next_extra < 2 && extras[next_extra].key < sign * value && budget > 0.0) {
+  auto give_extras_below = [&](double key) {
+    for (; next_extra < 2 && extras[next_extra].key < key && budget > 0.0; ++next_extra)
       give(extras[next_extra].value, extras[next_extra].slack);
-      ++next_extra;
-    }
-    const std::size_t k = position - first;  // wraps above count when before the window
-    const std::size_t safe = k < count ? k : 0;
-    if (budget > 0.0) give(value, k < count ? cells[safe].hi - cells[safe].lo : 0.0);
   };
-  if (length <= kMaskBits) {
-    // The window's cells with slack as bits at their ranks: visiting the set bits in increasing
-    // order visits exactly them, in filling order.
-    std::uint64_t mask[kMaskBits / 64] = {};
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::uint32_t r = rank[first + j];
-      mask[r / 64] |= std::uint64_t(cells[j].hi - cells[j].lo > 0.0) << (r % 64);
+  if (masked) {
+    for (std::size_t word = 0; word * 64 < length && budget > 0.0; ++word) {
+      for (std::uint64_t bits = mask[word]; bits && budget > 0.0; bits &= bits - 1) {
+        const std::size_t position = order[word * 64 + std::size_t(__builtin_ctzll(bits))];
+        const double value = line[position];
+        give_extras_below(sign * value);
+        if (!(budget > 0.0)) break;
+        const MassInterval& cell = cells[position - first];  // in the window, with slack
+        const double given = std::min(cell.hi - cell.lo, budget);
+        result += given * value;
+        budget -= given;
+      }
     }
-    for (std::size_t word = 0; word * 64 < length && budget > 0.0; ++word)
-      for (std::uint64_t bits = mask[word]; bits && budget > 0.0; bits &= bits - 1)
-        give_cell(order[word * 64 + std::size_t(__builtin_ctzll(bits))]);
   } else {
-    for (std::size_t r = 0; r < length && budget > 0.0; ++r) give_cell(order[r]);
+    for (std::size_t r = 0; r < length && budget > 0.0; ++r) {
+      const std::size_t position = order[r], k = position - first;  // k wraps above count before the window
+      const double value = line[position];
+      give_extras_below(sign * value);
+      if (k < count && budget > 0.0) give(value, cells[k].hi - cells[k].lo);
+    }
   }
   for (; next_extra < 2 && budget > 0.0; ++next_extra) give(extras[next_extra].value, extras[next_extra].slack);
   result = bound == Bound::Lower ? result - rounding : result + rounding;
@@ -105,6 +124,9 @@ ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound boun
   const std::size_t dims = states.dims();
   prefixes_.assign(dims, 1);
   tables_.resize(dims);
+  sums_.resize(dims);
+  for (std::size_t d = 0; d < dims; ++d)
+    for (std::uint32_t b = 0; b < rows.distinct_bounds(d); ++b) sums_[d].push_back(window_sums(rows.distinct(d, b)));
   for (std::size_t d = 1; d < dims; ++d) {
     prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
     tables_[d].resize(prefixes_[d] * rows.suffix_classes(d));
@@ -138,11 +160,12 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
     for (std::size_t suffix_class = first; suffix_class < last; ++suffix_class) {
       const RowBounds::SuffixParts parts = rows_.suffix_parts(d, std::uint32_t(suffix_class));
       const DimensionView& window = rows_.distinct(d, parts.bounds);
+      const WindowSums& sums = sums_[d][parts.bounds];
       for (std::size_t p = 0; p < prefixes; ++p) {
         const std::size_t line = (std::size_t(parts.next) * prefixes + p) * length;
         table[suffix_class * prefixes + p] =
             ordered_expectation(source + line, source_order_.order.data() + line, source_order_.rank.data() + line,
-                                length, window, bound_);
+                                length, window, sums, bound_);
       }
     }
   });
@@ -158,8 +181,9 @@ void ProductSweep::prepare(const double* values) {
 double ProductSweep::expectation(std::size_t row) const {
   const std::size_t length = states_.count(0);
   const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
+  const std::uint32_t bounds = rows_.bounds_index(row, 0);
   return ordered_expectation(stage0_lines_ + line, stage0_order_.order.data() + line,
-                             stage0_order_.rank.data() + line, length, rows_.distinct(0, rows_.bounds_index(row, 0)),
+                             stage0_order_.rank.data() + line, length, rows_.distinct(0, bounds), sums_[0][bounds],
                              bound_);
 }
 

@@ -16,6 +16,13 @@
 
 namespace amytiss::detail {
 
+/// Sums of a window's lower and upper bounds (cells, then leave, then cut: robust_expectation()'s
+/// order); window_sums() checks that they make a feasible row (std::logic_error otherwise).
+struct WindowSums {
+  double lo = 0.0, hi = 0.0;
+};
+WindowSums window_sums(const DimensionView& window);
+
 class ProductSweep {
  public:
   /// At most this many table entries (a double and a 32-bit position each).
@@ -47,6 +54,7 @@ class ProductSweep {
   unsigned threads_;
   std::vector<std::size_t> prefixes_;        // cells of dimensions 0..d-1
   std::vector<std::vector<double>> tables_;  // per dimension d >= 1
+  std::vector<std::vector<WindowSums>> sums_;  // per dimension and distinct bounds
   LineOrder source_order_;  // the current stage's source lines' order
   LineOrder stage0_order_;  // stage 0's lines' order
   const double* stage0_lines_ = nullptr;
@@ -55,9 +63,9 @@ class ProductSweep {
 /// One O-maximisation of robust_expectation() over a window of a line whose filling order is
 /// known: `line` holds the values of the dimension's grid cells, `order` their positions in the
 /// bound's filling order and `rank` each position's place in it, `window` the intervals (cells
-/// first.. of the line, leave worth 0, cut worth cut_value(bound)). The result is
-/// robust_expectation()'s, bit for bit.
+/// first.. of the line, leave worth 0, cut worth cut_value(bound)) with their window_sums(). The
+/// result is robust_expectation()'s, bit for bit.
 double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                           std::size_t length, const DimensionView& window, Bound bound);
+                           std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound);
 
 }  // namespace amytiss::detail
