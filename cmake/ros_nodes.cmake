@@ -5,6 +5,7 @@ add_library(amytiss_ros
   src/ros/checked_get_input.cpp
   src/ros/config_from_params.cpp
   src/ros/conversions.cpp
+  src/ros/node_process.cpp
   src/ros/plant_model.cpp
   src/ros/plant_simulator.cpp
   src/ros/policy_follower.cpp

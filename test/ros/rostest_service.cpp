@@ -139,7 +139,7 @@ TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStays
 }
 
 TEST_F(ServiceTest, ARequestClaimingMoreStateValuesThanItCarriesIsAnsweredWithoutTheAllocation) {
-  const int server = amytiss_test::node_pid("/amytiss/policy_server");
+  const int server = amytiss_ros::node_pid("/amytiss/policy_server");
   ASSERT_GT(server, 0);
   const long peak_before = peak_memory_kib(server);
   ASSERT_GT(peak_before, 0);
