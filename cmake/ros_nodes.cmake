@@ -5,6 +5,8 @@ add_library(amytiss_ros
   src/ros/checked_get_input.cpp
   src/ros/config_from_params.cpp
   src/ros/conversions.cpp
+  src/ros/immediate_callback_queue.cpp
+  src/ros/node_process.cpp
   src/ros/plant_model.cpp
   src/ros/plant_simulator.cpp
   src/ros/policy_follower.cpp
@@ -45,7 +47,8 @@ if(CATKIN_ENABLE_TESTING)
   # Conversions and parameters, no master needed.
   if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_conversions.cpp)
     catkin_add_gtest(amytiss_ros_unit_tests test/ros/test_conversions.cpp test/ros/test_synthesizer_monitor.cpp
-                     test/ros/test_policy_follower.cpp test/ros/test_checked_get_input.cpp)
+                     test/ros/test_policy_follower.cpp test/ros/test_checked_get_input.cpp
+                     test/ros/test_immediate_callback_queue.cpp)
     target_link_libraries(amytiss_ros_unit_tests amytiss_ros)
     target_compile_definitions(amytiss_ros_unit_tests PRIVATE AMYTISS_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
   endif()

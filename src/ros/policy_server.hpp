@@ -17,7 +17,8 @@
 //   topic   markers   (visualization_msgs/MarkerArray, latched) grid bounds, target, avoid, safe
 //   topic   /diagnostics (diagnostic_updater): policy loaded, its name, hash, run id and age,
 //                                              refused file, synthesizer alive or not, synthesis
-//                                              state, device
+//                                              state, device, get_input calls answered on the
+//                                              network thread and on a spinner thread
 // Private parameters: ~policy_file (string, optional: a policy to serve from the start, before
 // any status arrives), ~frame_id (string, default "map") for the markers,
 // ~synthesizer_timeout_s (double, default 3): no status for this long means the synthesizer
@@ -38,6 +39,7 @@
 #include <ros/ros.h>
 
 #include "amytiss/policy.hpp"
+#include "immediate_callback_queue.hpp"
 #include "policy_follower.hpp"
 #include "synthesizer_monitor.hpp"
 
@@ -73,6 +75,9 @@ class PolicyServerNode {
 
   ros::NodeHandle public_handle_, private_handle_;
   std::string frame_id_;
+  // get_input is answered on roscpp's network thread as each request is read (declared before
+  // service_, which uses it until it is shut down); every other callback goes to the spinners.
+  ImmediateCallbackQueue service_queue_;
   ros::ServiceServer service_;
   ros::Subscriber state_subscriber_, status_subscriber_;
   ros::Publisher command_publisher_, marker_publisher_;

@@ -1,6 +1,6 @@
 #pragma once
-// Rostest helpers that act on the nodes themselves: the process id of a running node, and
-// starting a node binary in the background.
+// Rostest helpers that act on the nodes themselves: starting a node binary in the background
+// and stopping it (the process id of a running node: amytiss_ros::node_pid).
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -9,29 +9,9 @@
 #include <string>
 #include <vector>
 
-#include <XmlRpcClient.h>
-#include <ros/master.h>
-#include <ros/network.h>
-#include <ros/ros.h>
+#include "node_process.hpp"
 
 namespace amytiss_test {
-
-/// The process id of a node (e.g. "/amytiss/policy_server"), asked through its XML-RPC API (as
-/// `rosnode info` does); -1 when the master or the node does not answer.
-inline int node_pid(const std::string& node) {
-  XmlRpc::XmlRpcValue request, response, payload;
-  request[0] = ros::this_node::getName();
-  request[1] = node;
-  if (!ros::master::execute("lookupNode", request, response, payload, true)) return -1;
-  std::string host;
-  uint32_t port = 0;
-  if (!ros::network::splitURI(std::string(payload), host, port)) return -1;
-  XmlRpc::XmlRpcClient client(host.c_str(), int(port), "/");
-  XmlRpc::XmlRpcValue pid_request, pid_response;
-  pid_request[0] = ros::this_node::getName();
-  if (!client.execute("getPid", pid_request, pid_response) || int(pid_response[0]) != 1) return -1;
-  return int(pid_response[2]);
-}
 
 /// Starts `arguments` (the binary first, then e.g. "__name:=policy_server", "__ns:=/amytiss");
 /// returns its process id, or 0 when it could not be started.

@@ -76,7 +76,7 @@ TEST_F(RestartTest, KilledSynthesizerIsReportedAndARestartedOneIsFollowedWithout
   action_.sendGoal(slow);
   ASSERT_TRUE(status_.wait_for([](const amytiss::PolicyStatus& s) { return s.synthesizing && s.percent > 0; },
                                30.0));
-  const int pid = amytiss_test::node_pid(kSynthesizer);
+  const int pid = amytiss_ros::node_pid(kSynthesizer);
   ASSERT_GT(pid, 0);
   ASSERT_EQ(0, ::kill(pid, SIGKILL));
 
@@ -122,7 +122,7 @@ TEST_F(RestartTest, ARestartedServerRefusesADamagedFileAndTheSynthesizerComputes
   ASSERT_THROW(amytiss::read_policy_file(served.policy_file), amytiss::PolicyFileError)
       << "the damage must be one the reader refuses";
 
-  const int old_server = amytiss_test::node_pid(kServer);
+  const int old_server = amytiss_ros::node_pid(kServer);
   ASSERT_GT(old_server, 0);
   ASSERT_EQ(0, ::kill(old_server, SIGKILL));
   ASSERT_GT(spawn({AMYTISS_POLICY_SERVER_BIN, "__name:=policy_server", "__ns:=/amytiss", "_synthesizer_timeout_s:=2.0"}),

@@ -1,15 +1,21 @@
 // rostest: the policy server's service and closed-loop topics against the core policy.
+#include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <condition_variable>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <random>
+#include <thread>
 
 #include <amytiss/GetInput.h>
 #include <amytiss/InputCommand.h>
 #include <amytiss/StateStamped.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
 
 #include "amytiss/policy_file.hpp"
 #include "rostest_nodes.hpp"
@@ -35,6 +41,12 @@ namespace {
 
 constexpr int kSampledStates = 300;
 constexpr unsigned kRandomSeed = 20240601;
+// Clients that call without pause, each on its own connection, and how long they keep at it at
+// least: longer than the server's default synthesizer_timeout_s (3 s), after which statuses it
+// did not read would make it report the synthesizer stopped.
+constexpr int kBusyClients = 4;
+constexpr double kBusySeconds = 4.0;
+constexpr std::size_t kAnswersPerBusyClient = 100;
 // Decoding the oversized request would allocate 4 GiB; the server may grow by far less than that.
 constexpr long kOversizedGrowthLimitKiB = 512L * 1024;
 
@@ -139,7 +151,7 @@ TEST_F(ServiceTest, EveryMalformedRequestIsAnsweredWithAMessageAndTheServerStays
 }
 
 TEST_F(ServiceTest, ARequestClaimingMoreStateValuesThanItCarriesIsAnsweredWithoutTheAllocation) {
-  const int server = amytiss_test::node_pid("/amytiss/policy_server");
+  const int server = amytiss_ros::node_pid("/amytiss/policy_server");
   ASSERT_GT(server, 0);
   const long peak_before = peak_memory_kib(server);
   ASSERT_GT(peak_before, 0);
@@ -194,6 +206,65 @@ TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {
   EXPECT_FALSE(commands[1].valid);
   EXPECT_TRUE(commands[1].input.empty());
   EXPECT_NE(commands[1].message.find("finite"), std::string::npos) << commands[1].message;
+}
+
+TEST_F(ServiceTest, UnderCallsWithoutPauseEveryClientIsAnsweredAndStatesTimersAndStatusesAreServed) {
+  std::atomic<bool> stop{false};
+  std::array<std::atomic<std::size_t>, kBusyClients> answers{}, failures{};
+  std::vector<std::thread> clients;
+  for (int c = 0; c < kBusyClients; ++c)
+    clients.emplace_back([&, c] {
+      ros::ServiceClient client = handle_.serviceClient<amytiss::GetInput>("/amytiss/get_input", /*persistent=*/true);
+      amytiss::GetInput service;
+      service.request.state = {-4.0, -4.0};
+      while (!stop) {
+        if (client.call(service) && service.response.success)
+          ++answers[c];
+        else
+          ++failures[c];
+      }
+    });
+  std::mutex mutex;
+  std::size_t commands = 0;
+  std::string network_thread_calls;  // the server's diagnostics value, as published
+  ros::Subscriber command_subscriber = handle_.subscribe<amytiss::InputCommand>(
+      "/amytiss/command", 10, [&](const amytiss::InputCommand::ConstPtr& command) {
+        std::lock_guard<std::mutex> lock(mutex);
+        commands += command->valid ? 1 : 0;
+      });
+  ros::Subscriber diagnostics_subscriber = handle_.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const auto& status : array->status)
+          for (const auto& pair : status.values)
+            if (pair.key == "get_input calls answered on the network thread") network_thread_calls = pair.value;
+      });
+  ros::Publisher state_publisher = handle_.advertise<amytiss::StateStamped>("/amytiss/state", 10);
+  amytiss::StateStamped state;
+  state.state = {-4.0, -4.0};
+  const ros::WallTime busy_until = ros::WallTime::now() + ros::WallDuration(kBusySeconds);
+  const bool served = amytiss_test::poll_until(
+      [&] {
+        state_publisher.publish(state);
+        std::lock_guard<std::mutex> lock(mutex);
+        const bool every_client_answered = std::all_of(
+            answers.begin(), answers.end(), [](const auto& count) { return count >= kAnswersPerBusyClient; });
+        return ros::WallTime::now() > busy_until && every_client_answered && commands > 0 &&
+               !network_thread_calls.empty() && network_thread_calls != "0";
+      },
+      kBusySeconds + amytiss_test::kServiceWaitSeconds);
+  // While the others still call: the answer carries no notice (the statuses kept arriving).
+  const amytiss::GetInput::Response during = call({-4.0, -4.0}, 0);
+  stop = true;
+  for (auto& client : clients) client.join();
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_TRUE(served) << "commands " << commands << ", network-thread calls '" << network_thread_calls << "'";
+  for (int c = 0; c < kBusyClients; ++c) {
+    EXPECT_GE(answers[c].load(), kAnswersPerBusyClient) << "client " << c;
+    EXPECT_EQ(failures[c].load(), 0u) << "client " << c;
+  }
+  EXPECT_TRUE(during.success);
+  EXPECT_EQ(during.message, "");
 }
 
 }  // namespace
