@@ -205,11 +205,15 @@ struct ComputeOverrides {
   std::string sweep;        ///< auto | dense | factored
   std::string platform;     ///< as compute.platform
   std::vector<std::string> devices;  ///< as compute.devices
+  /// abstraction | system: the top-level key `guarantee` (errors name key_prefix + "guarantee",
+  /// or "guarantee" with the default prefix).
+  std::string guarantee;
 };
 
-/// Replaces the compute keys the overrides give. The configuration is read but not yet validated:
-/// the caller validates after (config_from_yaml and load_config_file do). Throws ConfigError
-/// (key_prefix + key) for a device, transitions or sweep text that names no value.
+/// Replaces the compute keys (and the guarantee) the overrides give. The configuration is read
+/// but not yet validated: the caller validates after (config_from_yaml and load_config_file do).
+/// Throws ConfigError (key_prefix + key) for a device, transitions, sweep or guarantee text that
+/// names no value.
 void apply_overrides(Config& config, const ComputeOverrides& overrides);
 
 /// Reads a YAML tree of the schema without judging the values: throws ConfigError naming the key

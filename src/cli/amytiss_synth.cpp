@@ -38,7 +38,20 @@ Config load_with_overrides(const Options& options) {
   overrides.sweep = options.sweep;
   overrides.platform = options.platform;
   if (!options.devices.empty()) overrides.devices = split_list(options.devices);
+  overrides.guarantee = options.guarantee;
   return load_config_file(options.config_path, overrides);
+}
+
+// --at names a state of the grid: checked before anything is computed.
+void check_state_option(const Options& options, const Grid& states) {
+  if (options.at.empty()) return;
+  if (options.at.size() != states.dims())
+    throw UsageError("--at: got " + std::to_string(options.at.size()) + " values, expected " +
+                     std::to_string(states.dims()) + ", one per state dimension (x0 to x" +
+                     std::to_string(states.dims() - 1) + ")");
+  if (!states.cell_of(options.at.data()))
+    throw UsageError("--at: the state " + format_values(options.at) +
+                     " lies outside the grid (states.lb - eta/2 to states.ub + eta/2)");
 }
 
 void print_problem(const Options& options, const Config& config, const Abstraction& abstraction) {
@@ -99,6 +112,7 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   std::printf("  %-24s %s\n", "file write", format_seconds(write_seconds).c_str());
   if (options.profile) print_profile(report);
   print_value_summary(policy);
+  if (!options.at.empty()) print_values_at(policy, options.at);
   if (mpi.rank() == 0) print_apriori_error(abstraction);
   if (options.compare_reference) {
     const double engine_compute_seconds = report.phases.empty() ? synthesis_wall_seconds : compute_seconds(report);
@@ -123,6 +137,7 @@ int run(const Options& options, cli::MpiSession& mpi) {
   const Config config = load_with_overrides(options);
   const Abstraction abstraction = Abstraction::from_config(config);
   const double setup_seconds = seconds_since(setup_start);
+  check_state_option(options, abstraction.states);
   print_problem(options, config, abstraction);
   if (!options.export_format.empty()) return export_abstraction(options, abstraction);
   print_request(config, mpi);

@@ -1,6 +1,8 @@
 #include "options.hpp"
 
+#include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <vector>
 
 namespace amytiss::cli {
@@ -19,6 +21,8 @@ const char* const kUsage =
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
     "  --devices all|LIST                 overrides compute.devices: several devices, comma-separated\n"
     "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
+    "  --guarantee abstraction|system     overrides guarantee (system: bounds for the continuous system)\n"
+    "  --at X0,X1,...                     print the policy's values at this state (step 0) and its input\n"
     "  --dry-run                          print the plan (engine, devices, sweep, work split), compute nothing\n"
     "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
     "  --profile                          per-phase timing, rates and memory table\n"
@@ -35,6 +39,26 @@ const char* const kUsage =
     "exit status: 0 success, 2 bad input (configuration or options), 1 other failures\n";
 
 
+namespace {
+
+// "0.25,0.5,1.47" -> {0.25, 0.5, 1.47}; UsageError for an item that is not a finite number.
+std::vector<double> parse_state(const std::string& text) {
+  std::vector<double> state;
+  std::stringstream stream(text);
+  for (std::string item; std::getline(stream, item, ',');) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(value))
+      throw UsageError("--at: got '" + text + "', expected the state's values separated by commas (example: --at "
+                       "0.25,0.5,1.47)");
+    state.push_back(value);
+  }
+  if (state.empty()) throw UsageError("--at: got no values, expected the state's values (example: --at 0.25,0.5,1.47)");
+  return state;
+}
+
+}  // namespace
+
 Options parse_options(int argc, char** argv) {
   Options options;
   const std::vector<std::string> args(argv + 1, argv + argc);
@@ -50,6 +74,8 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--sweep") options.sweep = value();
     else if (arg == "--platform") options.platform = value();
     else if (arg == "--devices") options.devices = value();
+    else if (arg == "--guarantee") options.guarantee = value();
+    else if (arg == "--at") options.at = parse_state(value());
     else if (arg == "--dry-run") options.dry_run = true;
     else if (arg == "--output" || arg == "-o") options.output = value();
     else if (arg == "--export") {

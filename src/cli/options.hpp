@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace amytiss::cli {
 
@@ -22,6 +23,8 @@ struct Options {
   std::string sweep;        // empty: the configuration's
   std::string platform;
   std::string devices;      // empty: the configuration's
+  std::string guarantee;    // empty: the configuration's
+  std::vector<double> at;   // a state whose values to print after the synthesis; empty: none
   std::string output;
   std::string export_format;  // empty: no export
   std::string export_directory;

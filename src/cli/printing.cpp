@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "amytiss/apriori_error.hpp"
 #include "amytiss/engine.hpp"
@@ -198,6 +199,26 @@ void print_value_summary(const Policy& policy) {
   std::printf("unbounded: V_0 is the stationary policy's certified lower bound; upper bound mean %.6f, max %.6f; "
               "largest gap %.3g after %u interval iterations\n",
               bounds.upper.mean, bounds.upper.max, policy.gap, policy.iterations);
+}
+
+std::string format_values(const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + format_number(values[i]);
+  return text + "]";
+}
+
+void print_values_at(const Policy& policy, const std::vector<double>& state) {
+  std::vector<double> input(policy.inputs.dims());
+  double lower = 0.0, upper = 0.0;
+  const LookupStatus status = policy.lookup(state.data(), state.size(), 0, input.data(), &lower, &upper);
+  if (status != LookupStatus::Ok) throw std::logic_error(policy.describe(status, state.data(), state.size(), 0));
+  const std::string where = "at " + format_values(state);
+  const std::string with_input = input.empty() ? "" : ", input " + format_values(input);
+  if (policy.guarantee == Guarantee::System)
+    std::printf("%s: certified lower bound %.6f (this policy), upper bound %.6f (any controller)%s\n", where.c_str(),
+                lower, upper, with_input.c_str());
+  else
+    std::printf("%s: V_0 %.6f (the abstraction's value of its cell)%s\n", where.c_str(), lower, with_input.c_str());
 }
 
 // The paper's bound is one interval Jacobian per box of cells, input and disturbance: at most

@@ -2,6 +2,7 @@
 // amytiss_synth's output: the problem's sizes, the progress lines, the wall-time and profile
 // tables, the value summary and the comparison with the reference engine (docs/cli.md).
 #include <string>
+#include <vector>
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
@@ -30,6 +31,11 @@ void print_profile(const SynthesisReport& report);
 /// V_0 over the free cells; continuous-system bounds: min, mean and max of the lower bound, the
 /// upper bound and the gap; unbounded: also the upper bound and the gap.
 void print_value_summary(const Policy& policy);
+/// "[0.25, 0.5, 1.47]": values as the other lines print them.
+std::string format_values(const std::vector<double>& values);
+/// The policy at `state`, step 0: the value of its cell (continuous-system bounds: the certified
+/// lower bound and the upper bound) and the input. The state must lie in the grid.
+void print_values_at(const Policy& policy, const std::vector<double>& state);
 /// The paper's a-priori error of the abstraction (apriori_error.hpp), its Jacobians bounded in number.
 void print_apriori_error(const Abstraction& abstraction);
 /// Runs the reference engine too and prints the speed-up and max |dV_0| (with upper bounds: the

@@ -4,13 +4,18 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/format.hpp"
+#include "amytiss/policy.hpp"
 #include "amytiss/policy_file.hpp"
 #include "cli_support.hpp"
 
@@ -31,12 +36,18 @@ constexpr std::size_t kTinyStates = 81, kTinyInputs = 9;
 // Two runs of the same engine on the same problem agree exactly.
 constexpr double kSameEngineTolerance = 0.0;
 
+ComputeOverrides system_override() {
+  ComputeOverrides overrides;
+  overrides.guarantee = "system";
+  return overrides;
+}
+
 TEST_F(CliTest, HelpListsEveryOption) {
   const CommandResult result = synth("--help");
   EXPECT_EQ(0, result.exit_code) << result.err;
   for (const char* option : {"--config", "--device", "--transitions", "--platform", "--output",
                              "--profile", "--compare-reference", "--list-devices", "--quiet", "--export",
-                             "--export-max-transitions"})
+                             "--export-max-transitions", "--guarantee", "--at"})
     EXPECT_CONTAINS(result.out, option);
 }
 
@@ -171,6 +182,53 @@ TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
         "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
         "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "})
     EXPECT_CONTAINS(result.out, line);
+}
+
+// The number after `label` in the output, or NaN.
+double number_after(const std::string& out, const std::string& label) {
+  const std::size_t at = out.find(label);
+  return at == std::string::npos ? std::nan("") : std::stod(out.substr(at + label.size()));
+}
+
+// --at prints the values of the state's cell as the written policy holds them, and its input.
+TEST_F(CliTest, AtPrintsTheValuesOfTheStatesCell) {
+  constexpr double kPrintedRounding = 5e-7;  // six decimals
+  const std::vector<double> state = {-2.2, 1.1};
+  CommandResult result = synth("--config " + quote(kTinyConfig) + " --quiet --output tiny.h5 --at -2.2,1.1");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  LoadedPolicy loaded = read_policy_file_for(path("tiny.h5"), load_config_file(kTinyConfig));
+  std::vector<double> input(2);
+  double lower = 0.0, upper = 0.0;
+  ASSERT_EQ(loaded.policy.lookup(state.data(), state.size(), 0, input.data(), &lower, &upper), LookupStatus::Ok);
+  EXPECT_NEAR(number_after(result.out, "at [-2.2, 1.1]: V_0 "), lower, kPrintedRounding) << result.out;
+  EXPECT_CONTAINS(result.out, "input [" + format_number(input[0]) + ", " + format_number(input[1]) + "]");
+
+  // --guarantee system: the certified lower bound and the upper bound of the same cell.
+  result = synth("--config " + quote(kTinyConfig) + " --quiet --guarantee system --output system.h5 --at -2.2,1.1");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  loaded = read_policy_file_for(path("system.h5"), load_config_file(kTinyConfig, system_override()));
+  ASSERT_EQ(loaded.policy.guarantee, Guarantee::System);
+  ASSERT_EQ(loaded.policy.lookup(state.data(), state.size(), 0, input.data(), &lower, &upper), LookupStatus::Ok);
+  ASSERT_LT(lower, upper) << "a cell whose bounds differ shows that each is read from its own array";
+  EXPECT_NEAR(number_after(result.out, "at [-2.2, 1.1]: certified lower bound "), lower, kPrintedRounding);
+  EXPECT_NEAR(number_after(result.out, "(this policy), upper bound "), upper, kPrintedRounding) << result.out;
+}
+
+// A state of the wrong length or outside the grid, or an unknown guarantee, is refused before
+// anything is computed (exit status 2, no file).
+TEST_F(CliTest, BadStatesAndGuaranteesExitTwoBeforeComputing) {
+  const std::string base = "--config " + quote(kTinyConfig) + " --quiet --output refused.h5 ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--at 1", "--at: got 1 values, expected 2, one per state dimension (x0 to x1)"},
+      {"--at 1,x", "--at: got '1,x', expected the state's values separated by commas"},
+      {"--at 9,0", "--at: the state [9, 0] lies outside the grid"},
+      {"--guarantee certified", "--guarantee: got 'certified', expected one of"}};
+  for (const auto& [arguments, message] : cases) {
+    const CommandResult result = synth(base + arguments);
+    EXPECT_EQ(2, result.exit_code) << arguments;
+    EXPECT_CONTAINS(result.err, message);
+    EXPECT_FALSE(fs::exists(path("refused.h5"))) << arguments;
+  }
 }
 
 TEST_F(CliTest, BadConfigurationExitsTwoNamingTheKey) {

@@ -87,6 +87,28 @@ TEST(ConfigGate, OverridesComeBeforeTheOneValidation) {
   EXPECT_EQ(error_key([&] { config_from_yaml(YAML::Load(kTiny), unknown); }), "--sweep");
 }
 
+// The guarantee (a top-level key) is overridden like the compute keys, before the one validation
+// (which refuses a device the continuous-system bounds cannot use), and named without "compute.".
+TEST(ConfigGate, TheGuaranteeIsOverriddenBeforeTheOneValidation) {
+  ComputeOverrides system;
+  system.guarantee = "system";
+  EXPECT_EQ(config_from_yaml(YAML::Load(kTiny), system).guarantee, Guarantee::System);
+  YAML::Node root = YAML::Load(kTiny);
+  root["guarantee"] = "system";
+  ComputeOverrides abstraction;
+  abstraction.guarantee = "abstraction";
+  EXPECT_EQ(config_from_yaml(root, abstraction).guarantee, Guarantee::Abstraction);
+  ComputeOverrides on_cpu = system;
+  on_cpu.device = "cpu";
+  EXPECT_EQ(error_key([&] { config_from_yaml(YAML::Load(kTiny), on_cpu); }), "compute.device");
+
+  ComputeOverrides unknown;
+  unknown.guarantee = "certified";
+  EXPECT_EQ(error_key([&] { config_from_yaml(YAML::Load(kTiny), unknown); }), "guarantee");
+  unknown.key_prefix = "--";
+  EXPECT_EQ(error_key([&] { config_from_yaml(YAML::Load(kTiny), unknown); }), "--guarantee");
+}
+
 TEST(ConfigGate, ApplyOverridesReplacesOnlyWhatIsGiven) {
   Config config = read_config(YAML::Load(kTiny));
   config.compute.platform = "pocl";
@@ -98,6 +120,7 @@ TEST(ConfigGate, ApplyOverridesReplacesOnlyWhatIsGiven) {
   EXPECT_EQ(config.compute.sweep, SweepChoice::Dense);
   EXPECT_EQ(config.compute.device, DeviceKind::Auto);
   EXPECT_EQ(config.compute.platform, "pocl");
+  EXPECT_EQ(config.guarantee, Guarantee::Abstraction);
 }
 
 // Abstraction::from_config builds from what validate() passed and does not judge it again: a

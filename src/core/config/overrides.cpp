@@ -1,5 +1,5 @@
-// The compute keys given beside a configuration (CLI options, the ROS ~device parameter) replace
-// the configuration's before Config::validate() judges the whole.
+// The compute keys and the guarantee given beside a configuration (CLI options, the ROS ~device
+// parameter) replace the configuration's before Config::validate() judges the whole.
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
 #include "config/messages.hpp"
@@ -24,6 +24,8 @@ void apply_overrides(Config& config, const ComputeOverrides& overrides) {
   override_enum(compute.sweep, overrides.sweep, overrides.key_prefix + "sweep");
   if (!overrides.platform.empty()) compute.platform = overrides.platform;
   if (!overrides.devices.empty()) compute.devices = overrides.devices;
+  const bool default_prefix = overrides.key_prefix == ComputeOverrides{}.key_prefix;
+  override_enum(config.guarantee, overrides.guarantee, default_prefix ? "guarantee" : overrides.key_prefix + "guarantee");
 }
 
 }  // namespace amytiss
