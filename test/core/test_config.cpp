@@ -439,7 +439,7 @@ TEST(Config, CanonicalYamlRoundTrips) {
   for (const char* file : {"config/robot_safety.yaml", "config/bmw_paper.yaml", "config/stochy_14d.yaml",
                            "test/data/tiny_reach_avoid.yaml", "test/data/tiny_safety_disturbance.yaml",
                            "test/data/tiny_autonomous.yaml", "config/arch_van_der_pol_infinite.yaml",
-                           "config/arch_building_automation_7d.yaml"}) {
+                           "config/arch_building_automation_7d.yaml", "config/bmw_final_approach.yaml"}) {
     const Config config = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/" + file);
     const std::string text = to_yaml(config);
     const Config again = config_from_yaml(YAML::Load(text));

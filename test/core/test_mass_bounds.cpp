@@ -204,6 +204,15 @@ TEST(MassBounds, ZeroScaleIsAPointMass) {
   const MassInterval across = d.bounds.bounds(0.0, 0.2, 0.15, 0.25, 0.0, 0.0);
   EXPECT_EQ(across.lo, 0.0);
   EXPECT_EQ(across.hi, 1.0);
+  // A closed image as wide as the cell (a deterministic step of exactly one cell) reaches the next
+  // cell's lower face: the point may lie in either cell (docs/bmw_parking.md, "A certified final
+  // approach").
+  const MassInterval whole = d.bounds.bounds(0.0, 0.2, 0.0, 0.2, 0.0, 0.0);
+  EXPECT_EQ(whole.lo, 0.0);
+  EXPECT_EQ(whole.hi, 1.0);
+  const MassInterval next = d.bounds.bounds(0.2, 0.4, 0.0, 0.2, 0.0, 0.0);
+  EXPECT_EQ(next.lo, 0.0);
+  EXPECT_EQ(next.hi, 1.0);
 }
 
 TEST(MassBounds, FullCovarianceIsAConfigError) {

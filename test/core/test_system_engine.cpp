@@ -4,12 +4,15 @@
 // unbounded specifications with sound bounds, and the plan and validation refuse what it cannot run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "amytiss/enclosure.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/grid.hpp"
 #include "amytiss/policy_file.hpp"
 #include "host/enclosure_mean_box.hpp"
 #include "host/robust_reference.hpp"
@@ -147,6 +150,31 @@ TEST(SystemEngine, OpenClDevicesAndFullCovariancesAreRefusedNamingTheKey) {
   } catch (const ConfigError& error) {
     EXPECT_NE(std::string(error.what()).find("noise.covariance"), std::string::npos) << error.what();
   }
+}
+
+std::size_t count_targets(const std::vector<CellRole>& roles) {
+  return std::size_t(std::count(roles.begin(), roles.end(), CellRole::FixedOne));
+}
+
+// The lower bound counts a cell as target only when the whole cell lies inside the target. The
+// demo's certified car (config/bmw_final_approach.yaml) draws its target on the cells' faces, so
+// the lower bound's targets are the abstraction's; the parking problem's target asks for a speed
+// of exactly 0 and no cell lies inside it, so its lower bound would be 0 everywhere.
+TEST(SystemEngine, TheCertifiedCarsTargetIsWholeCellsAndTheParkingTargetHoldsNone) {
+  const std::string source = AMYTISS_SOURCE_DIR;
+  const Config approach = load_config_file(source + "/config/bmw_final_approach.yaml");
+  EXPECT_EQ(approach.guarantee, Guarantee::System);
+  const Grid approach_states(approach.states);
+  const std::vector<CellRole> lower = robust_cell_roles(approach_states, approach.spec, Bound::Lower);
+  const std::vector<CellRole> abstraction = cell_roles(approach_states, approach.spec);
+  EXPECT_GT(count_targets(lower), 0u);
+  for (std::size_t x = 0; x < lower.size(); ++x)
+    ASSERT_EQ(lower[x] == CellRole::FixedOne, abstraction[x] == CellRole::FixedOne) << "cell " << x;
+
+  const Config parking = load_config_file(source + "/config/bmw_parking.yaml");
+  const Grid parking_states(parking.states);
+  EXPECT_GT(count_targets(cell_roles(parking_states, parking.spec)), 0u);
+  EXPECT_EQ(count_targets(robust_cell_roles(parking_states, parking.spec, Bound::Lower)), 0u);
 }
 
 }  // namespace
