@@ -5,6 +5,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
+#include "host/system_engine.hpp"
 #include "opencl/layout.hpp"
 #include "opencl/run.hpp"
 #include "opencl/sweep_choice.hpp"
@@ -130,6 +131,11 @@ std::vector<std::string> describe_plan(const Abstraction& a, SynthesisPlan& plan
     SynthesisReport storage;
     plan_run(a, Layout(a), plan.device, options.compute, {}, storage);
     lines.push_back("transitions: " + storage.transitions);
+  }
+  if (plan.engine == EngineKind::Bounds) {
+    const std::string targets =
+        lower_targets_text(robust_cell_roles(a.states, a.config.spec, Bound::Lower), a.config.spec.type);
+    if (!targets.empty()) lines.push_back("continuous-system bounds: " + targets);
   }
   if (plan.engine != EngineKind::Team) return lines;
   Team& team = *plan.team->team;

@@ -177,5 +177,42 @@ TEST(SystemEngine, TheCertifiedCarsTargetIsWholeCellsAndTheParkingTargetHoldsNon
   EXPECT_EQ(count_targets(robust_cell_roles(parking_states, parking.spec, Bound::Lower)), 0u);
 }
 
+bool has_line(const std::vector<std::string>& lines, const std::string& text) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& line) { return line.find(text) != line.npos; });
+}
+
+// The plan (--dry-run) and the run's notes say how many cells the lower bound counts as target,
+// and warn when there is none: the lower bound is then 0 everywhere.
+TEST(SystemEngine, PlanAndNotesCountTheLowerBoundsTargetCells) {
+  const Abstraction a = from_yaml(with_system(small_3d_yaml(1)));
+  const std::size_t inside = count_targets(robust_cell_roles(a.states, a.config.spec, Bound::Lower));
+  ASSERT_GT(inside, 0u);
+  ASSERT_LT(inside, count_targets(a.roles)) << "the target's edge cells hold target points but are not inside";
+  const std::string counted = std::to_string(inside) + " of " + std::to_string(a.states.size()) +
+                              " cells lie wholly inside the target (the lower bound's target cells)";
+  EXPECT_TRUE(has_line(describe_synthesis(a, options_for(DeviceKind::Auto)), "continuous-system bounds: " + counted));
+  SynthesisReport report;
+  synthesize(a, options_for(DeviceKind::Auto), &report);
+  EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(), [&](const EngineNote& note) {
+    return note.text == counted && note.severity == NoteSeverity::Info;
+  }));
+
+  // A target inside one cell: no cell lies inside it.
+  std::string yaml = small_3d_yaml(1);
+  const std::string target = "target: {lb: [1, -2, -1], ub: [2, 2, 1]}";
+  yaml.replace(yaml.find(target), target.size(), "target: {lb: [1.4, -0.1, -0.1], ub: [1.6, 0.1, 0.1]}");
+  const Abstraction point = from_yaml(with_system(yaml));
+  const std::string none = "0 of " + std::to_string(point.states.size()) +
+                           " cells lie wholly inside the target (the lower bound's target cells): the lower bound "
+                           "is 0 everywhere";
+  EXPECT_TRUE(has_line(describe_synthesis(point, options_for(DeviceKind::Auto)), none));
+  SynthesisReport warned;
+  const Policy policy = synthesize(point, options_for(DeviceKind::Auto), &warned);
+  EXPECT_TRUE(std::any_of(warned.notes.begin(), warned.notes.end(), [&](const EngineNote& note) {
+    return note.text.find(none) == 0 && note.severity == NoteSeverity::Warning;
+  }));
+  for (std::size_t x = 0; x < point.states.size(); ++x) ASSERT_EQ(policy.value(0, x), 0.0) << "cell " << x;
+}
+
 }  // namespace
 }  // namespace amytiss::detail

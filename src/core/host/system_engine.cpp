@@ -1,5 +1,7 @@
 #include "host/system_engine.hpp"
 
+#include <algorithm>
+
 #include "amytiss/enclosure.hpp"
 #include "amytiss/format.hpp"
 #include "host/enclosure_mean_box.hpp"
@@ -17,6 +19,12 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
   const auto construction_start = SteadyClock::now();
   std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
   std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
+  const std::string targets = lower_targets_text(lower_roles, a.config.spec.type);
+  const bool no_target = std::none_of(lower_roles.begin(), lower_roles.end(),
+                                      [](CellRole role) { return role == CellRole::FixedOne; });
+  if (!targets.empty())
+    reporter.report().notes.push_back(
+        {no_target ? NoteSeverity::Warning : NoteSeverity::Info, NoteKind::Transitions, targets});
   std::vector<bool> needed(a.states.size());
   for (std::size_t x = 0; x < needed.size(); ++x)
     needed[x] = lower_roles[x] == CellRole::Free || upper_roles[x] == CellRole::Free;
@@ -39,6 +47,16 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
   IntervalStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads);
   IntervalStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads);
   return run_backward_bounds(a, lower, upper, reporter);
+}
+
+std::string lower_targets_text(const std::vector<CellRole>& lower_roles, SpecType spec) {
+  if (spec == SpecType::Safety) return "";
+  const auto inside = std::size_t(std::count(lower_roles.begin(), lower_roles.end(), CellRole::FixedOne));
+  std::string text = std::to_string(inside) + " of " + std::to_string(lower_roles.size()) +
+                     " cells lie wholly inside the target (the lower bound's target cells)";
+  if (inside == 0)
+    text += ": the lower bound is 0 everywhere; draw the target on the cells' faces, lb + (k +- 1/2) eta";
+  return text;
 }
 
 }  // namespace amytiss::detail
