@@ -1,5 +1,6 @@
 #include "plant_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -59,14 +60,36 @@ std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const st
   return text;
 }
 
+namespace {
+
+constexpr double kStandardErrors = 4.0;
+
+// kStandardErrors binomial standard errors of a rate over `episodes` whose true value is p.
+double rate_tolerance(double p, unsigned episodes) {
+  return episodes ? kStandardErrors * std::sqrt(p * (1 - p) / episodes) : 0.0;
+}
+
+}  // namespace
+
 std::string consistency_text(unsigned successes, unsigned episodes, double predicted) {
-  constexpr double kStandardErrors = 4.0;
   const double rate = episodes ? double(successes) / episodes : 0.0;
-  const double bound = episodes ? kStandardErrors * std::sqrt(predicted * (1 - predicted) / episodes) : 0.0;
+  const double bound = rate_tolerance(predicted, episodes);
   const double difference = std::abs(rate - predicted);
   char text[200];
   std::snprintf(text, sizeof text, "|rate - V_0| = %.4f, 4 standard errors of V_0 over %u episodes = %.4f: %s",
                 difference, episodes, bound, difference <= bound ? "consistent" : "NOT consistent");
+  return text;
+}
+
+std::string bounds_consistency_text(unsigned successes, unsigned episodes, double lower, double upper) {
+  const double rate = episodes ? double(successes) / episodes : 0.0;
+  const double low = std::max(0.0, lower - rate_tolerance(lower, episodes));
+  const double high = std::min(1.0, upper + rate_tolerance(upper, episodes));
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "rate %.4f against [lower - 4 standard errors, upper + 4 standard errors] = [%.4f, %.4f] over %u "
+                "episodes: %s",
+                rate, low, high, episodes, low <= rate && rate <= high ? "consistent" : "NOT consistent");
   return text;
 }
 

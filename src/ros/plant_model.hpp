@@ -62,6 +62,11 @@ std::string vehicle_motion_text(const amytiss::VehicleOutline& outline, const st
 /// "NOT consistent"): the empirical success rate against the prediction, with the binomial
 /// standard error sqrt(V_0 (1 - V_0) / episodes) of a rate whose true value is V_0.
 std::string consistency_text(unsigned successes, unsigned episodes, double predicted);
+/// "rate 0.9500 against [lower - 4 standard errors, upper + 4 standard errors] = [0.4182, 1.0000]
+/// over 20 episodes: consistent" (or "NOT consistent"): the empirical success rate against the
+/// continuous-system bounds of the start state's cell (guarantee: system), each widened by four
+/// binomial standard errors of a rate whose true value is that bound.
+std::string bounds_consistency_text(unsigned successes, unsigned episodes, double lower, double upper);
 
 /// Outcome of an episode that ended at `step` in a state of class `state_class` (for Free: the
 /// horizon is over). Reach specs succeed on Target; safety succeeds when the horizon is over.

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -48,6 +49,18 @@ void PlantSimulatorNode::on_command(const amytiss::InputCommand::ConstPtr& comma
 }
 
 namespace {
+
+std::string format4(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4f", value);
+  return text;
+}
+
+// The bounds of a policy with guarantee: system at a state's cell.
+std::string bounds_text(double lower, double upper) {
+  return "certified lower bound for the continuous system (guarantee: system) = " + format4(lower) +
+         ", upper bound " + format4(upper);
+}
 
 std::string join(const std::vector<double>& values) {
   std::ostringstream text;
@@ -279,12 +292,15 @@ int PlantSimulatorNode::run() {
     return 1;
   }
   std::vector<double> predicted_input(policy.inputs.dims());
-  double predicted = 0.0;
-  if (policy.lookup(initial_state.data(), initial_state.size(), 0, predicted_input.data(), &predicted) !=
+  double predicted = 0.0, upper = 0.0;
+  if (policy.lookup(initial_state.data(), initial_state.size(), 0, predicted_input.data(), &predicted, &upper) !=
       amytiss::LookupStatus::Ok)
-    predicted = 0.0;
-  ROS_INFO("plant simulator: '%s', %d episodes from [%s], seed %d; predicted V_0 = %.4f",
-           simulation.config.name.c_str(), settings_.episodes, join(initial_state).c_str(), settings_.seed, predicted);
+    predicted = upper = 0.0;
+  // With guarantee: system, V_0 is the certified lower bound for the continuous system.
+  const bool certified = policy.guarantee == amytiss::Guarantee::System;
+  const std::string prediction = certified ? bounds_text(predicted, upper) : "predicted V_0 = " + format4(predicted);
+  ROS_INFO("plant simulator: '%s', %d episodes from [%s], seed %d; %s", simulation.config.name.c_str(),
+           settings_.episodes, join(initial_state).c_str(), settings_.seed, prediction.c_str());
   if (!wait_for_server(settings_.command_timeout_s * 4)) {
     ROS_ERROR("plant simulator: the policy server is not connected to %s / %s", state_publisher_.getTopic().c_str(),
               command_subscriber_.getTopic().c_str());
@@ -299,10 +315,11 @@ int PlantSimulatorNode::run() {
   summary.success_rate = summary.episodes ? double(summary.successes) / summary.episodes : 0.0;
   const double standard_error =
       summary.episodes ? std::sqrt(summary.success_rate * (1 - summary.success_rate) / summary.episodes) : 0.0;
-  ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); predicted V_0 at the "
-           "start state = %.4f",
-           summary.successes, summary.episodes, summary.success_rate, standard_error, predicted);
-  ROS_INFO("plant simulator: %s", consistency_text(summary.successes, summary.episodes, predicted).c_str());
+  ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); %s at the start state",
+           summary.successes, summary.episodes, summary.success_rate, standard_error, prediction.c_str());
+  ROS_INFO("plant simulator: %s", certified
+                                      ? bounds_consistency_text(summary.successes, summary.episodes, predicted, upper).c_str()
+                                      : consistency_text(summary.successes, summary.episodes, predicted).c_str());
   if (!settings_.plot_script.empty()) draw_pictures(simulation, summary.csv_file, base, summary);
   ROS_INFO("trajectories: %s", summary.csv_file.c_str());
   summary.header.stamp = ros::Time::now();

@@ -495,6 +495,18 @@ TEST(Outcomes, ConsistencyOfTheRateWithV0) {
             "|rate - V_0| = 0.2486, 4 standard errors of V_0 over 20 episodes = 0.0334: NOT consistent");
 }
 
+TEST(Outcomes, ConsistencyOfTheRateWithTheCertifiedBounds) {
+  // Lower 0.7854 over 20 episodes: 4 standard errors 4 sqrt(0.7854 * 0.2146 / 20) = 0.3672; an
+  // upper bound of 1 has none. Lower 0.1, upper 0.2: 0.2 + 4 sqrt(0.2 * 0.8 / 20) = 0.5578.
+  const std::string limits = " against [lower - 4 standard errors, upper + 4 standard errors] = ";
+  EXPECT_EQ(amytiss_ros::bounds_consistency_text(19, 20, 0.7854, 1.0),
+            "rate 0.9500" + limits + "[0.4182, 1.0000] over 20 episodes: consistent");
+  EXPECT_EQ(amytiss_ros::bounds_consistency_text(5, 20, 0.7854, 1.0),
+            "rate 0.2500" + limits + "[0.4182, 1.0000] over 20 episodes: NOT consistent");
+  EXPECT_EQ(amytiss_ros::bounds_consistency_text(20, 20, 0.1, 0.2),
+            "rate 1.0000" + limits + "[0.0000, 0.5578] over 20 episodes: NOT consistent");
+}
+
 TEST(Outcomes, ClassifyByCellRole) {
   const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
   amytiss::Policy policy;
