@@ -315,8 +315,10 @@ int PlantSimulatorNode::run() {
   summary.success_rate = summary.episodes ? double(summary.successes) / summary.episodes : 0.0;
   const double standard_error =
       summary.episodes ? std::sqrt(summary.success_rate * (1 - summary.success_rate) / summary.episodes) : 0.0;
-  ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); %s at the start state",
-           summary.successes, summary.episodes, summary.success_rate, standard_error, prediction.c_str());
+  const std::string at_start = certified ? prediction + " at the start state"
+                                         : "predicted V_0 at the start state = " + format4(predicted);
+  ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); %s", summary.successes,
+           summary.episodes, summary.success_rate, standard_error, at_start.c_str());
   ROS_INFO("plant simulator: %s", certified
                                       ? bounds_consistency_text(summary.successes, summary.episodes, predicted, upper).c_str()
                                       : consistency_text(summary.successes, summary.episodes, predicted).c_str());
