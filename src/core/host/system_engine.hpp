@@ -16,7 +16,7 @@ namespace amytiss::detail {
 /// abstraction's configuration gives the system map (ImageEnclosure) and the sets.
 Policy run_system_bounds(const Abstraction& abstraction, AmbiguitySet set, StepReporter& reporter);
 
-/// Reach specifications: "459 of 30525 cells lie wholly inside the target (the lower bound's target
+/// Reach specifications: "891 of 60125 cells lie wholly inside the target (the lower bound's target
 /// cells)"; with none, also that the lower bound is then 0 everywhere and how to draw the target.
 /// Empty for safety. `lower_roles`: robust_cell_roles() of the lower bound.
 std::string lower_targets_text(const std::vector<CellRole>& lower_roles, SpecType spec);
