@@ -1,7 +1,7 @@
 // The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
-// ties, the leave and cut outcomes); the sweep gives product_expectation()'s row by row; rows
-// that share a mean box through what the map reads get the bounds they would compute themselves.
+// ties, the leave and cut outcomes); the sweep gives product_expectation()'s row by row, and its
+// estimate for the input choice is never below it; rows that share a mean box through what the map reads get the bounds they would compute themselves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -139,8 +139,11 @@ TEST(ProductSweep, SweepGivesTheRowByRowProductBound) {
     ProductScratch scratch;
     for (std::size_t row = 0; row < a.triples(); ++row) {
       rows.dimensions(row, views.data());
-      ASSERT_EQ(sweep.expectation(row), product_expectation(a.states, views.data(), values.data(), bound, scratch))
+      const double expectation = sweep.expectation(row);
+      ASSERT_EQ(expectation, product_expectation(a.states, views.data(), values.data(), bound, scratch))
           << "row " << row;
+      // What the input choice skips by: never below the row's bound.
+      ASSERT_GE(sweep.upper_estimate(row), expectation) << "row " << row;
     }
   }
 }

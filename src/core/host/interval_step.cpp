@@ -13,6 +13,7 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
   if (set_ != AmbiguitySet::Product) return;
   if (ProductSweep::pays(a_.states, rows_, a_.triples())) {
     sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_);
+    last_choice_.assign(a_.states.size(), 0);
     return;
   }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
@@ -60,6 +61,13 @@ double IntervalStep::worst_case(std::size_t cell, std::size_t input, const doubl
   return worst;
 }
 
+double IntervalStep::estimate(std::size_t cell, std::size_t input) const {
+  double estimate = std::numeric_limits<double>::infinity();
+  for (std::size_t w = 0; w < a_.disturbances.size(); ++w)
+    estimate = std::min(estimate, sweep_->upper_estimate(rows_.row(cell, input, w)));
+  return estimate;
+}
+
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   reset_stage_caches();
   if (sweep_) sweep_->prepare(in);
@@ -72,14 +80,25 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
         out[cell] = a_.terminal_value(roles_[cell]);
         continue;
       }
-      double best = -1.0;
+      // The maximiser with the lowest index. With the sweep, the input chosen at the previous step
+      // goes first, and an input whose estimate cannot beat the best so far is skipped: it can
+      // only tie with it when its index is lower, so those need a strictly lower estimate.
+      const std::size_t seed = sweep_ ? last_choice_[cell] : 0;
+      double best = worst_case(cell, seed, in, scratch);
+      chosen[cell] = std::uint32_t(seed);
       for (std::size_t u = 0; u < a_.inputs.size(); ++u) {
+        if (u == seed) continue;
+        if (sweep_) {
+          const double most = estimate(cell, u);
+          if (most < best || (most == best && u > chosen[cell])) continue;
+        }
         const double value = worst_case(cell, u, in, scratch);
-        if (value > best) {  // ties keep the lowest input
+        if (value > best || (value == best && u < chosen[cell])) {
           best = value;
           chosen[cell] = std::uint32_t(u);
         }
       }
+      if (sweep_) last_choice_[cell] = chosen[cell];
       out[cell] = best;
     }
   });

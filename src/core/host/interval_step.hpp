@@ -35,6 +35,8 @@ class IntervalStep : public BellmanStep {
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
+  // At least worst_case() (sweep only): min over disturbances of ProductSweep::upper_estimate().
+  double estimate(std::size_t cell, std::size_t input) const;
   void reset_stage_caches();
   void use_stage_caches(ProductScratch& scratch) const;
   const Abstraction& a_;
@@ -49,6 +51,7 @@ class IntervalStep : public BellmanStep {
   std::vector<std::size_t> stage_cache_entries_;
   // The product set over whole tables where it pays (host/product_sweep.hpp); then no caches.
   std::unique_ptr<ProductSweep> sweep_;
+  std::vector<std::uint32_t> last_choice_;  // per cell, the input apply() chose last (sweep only)
 };
 
 }  // namespace amytiss::detail

@@ -188,3 +188,29 @@ double ProductSweep::expectation(std::size_t row) const {
 }
 
 }  // namespace amytiss::detail
+
+namespace amytiss::detail {
+
+double ProductSweep::upper_estimate(std::size_t row) const {
+  const std::size_t length = states_.count(0);
+  const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
+  const DimensionView& window = rows_.distinct(0, rows_.bounds_index(row, 0));
+  const std::uint32_t* order = stage0_order_.order.data() + line;
+  const std::size_t first = std::size_t(window.first);
+  // The window's largest value: the last of its cells in the filling order (Lower), the first
+  // (Upper). Leave is worth 0.
+  double largest = 0.0;
+  for (std::size_t i = 0; i < length; ++i) {
+    const std::size_t position = order[bound_ == Bound::Lower ? length - 1 - i : i];
+    if (position - first < window.count) {
+      largest = stage0_lines_[line + position];
+      break;
+    }
+  }
+  // Any distribution's expectation is at most its largest value; the cut (worth 1 to the upper
+  // bound) takes at most cut.hi.
+  const double estimate = bound_ == Bound::Upper ? largest + window.cut.hi * (1.0 - largest) : largest;
+  return estimate + kEstimateMargin;
+}
+
+}  // namespace amytiss::detail

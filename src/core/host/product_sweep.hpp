@@ -38,6 +38,12 @@ class ProductSweep {
   void prepare(const double* values);
   /// Stage 0 of `row` over the values of the last prepare(): the row's product bound.
   double expectation(std::size_t row) const;
+  /// At least expectation(row), from the largest value the row's stage 0 can take (a few reads):
+  /// an input whose estimate is not above the best value so far cannot be the maximiser.
+  double upper_estimate(std::size_t row) const;
+  /// What upper_estimate() adds for the outward rounding of expectation() (at most
+  /// robust_expectation_rounding() of a few hundred outcomes, about 1e-13).
+  static constexpr double kEstimateMargin = 1e-9;
 
  private:
   // Stage d's table, [suffix class][prefix], from its source's lines.
