@@ -47,12 +47,10 @@ unsigned host_threads() { return std::max(1u, std::thread::hardware_concurrency(
 
 namespace {
 
-// The arguments that determine one dimension's bounds, compared bit for bit.
-struct BoundsKey {
-  double m_lo, m_hi, s_lo, s_hi;
-  bool operator==(const BoundsKey& other) const {
-    return std::memcmp(this, &other, sizeof(BoundsKey)) == 0;
-  }
+using BoundsKey = RowBounds::BoundsKey;
+// Keys compared bit for bit.
+struct BoundsKeyEqual {
+  bool operator()(const BoundsKey& a, const BoundsKey& b) const { return std::memcmp(&a, &b, sizeof(BoundsKey)) == 0; }
 };
 struct BoundsKeyHash {
   std::size_t operator()(const BoundsKey& key) const {
@@ -64,13 +62,10 @@ struct BoundsKeyHash {
   }
 };
 
-// One worker's distinct bounds: per dimension the views (cells as offsets into the pool until
-// the pool stops growing) and the index of each key.
+// One worker's distinct keys per dimension, in the order met, and the index of each.
 struct WorkerTables {
-  std::vector<MassInterval> pool;
-  std::vector<std::vector<DimensionView>> distinct;
-  std::vector<std::vector<std::size_t>> pool_offset;
-  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash>> index;
+  std::vector<std::vector<BoundsKey>> keys;
+  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash, BoundsKeyEqual>> index;
 };
 
 }  // namespace
@@ -122,8 +117,7 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
   std::vector<WorkerTables> tables(threads);
   parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
     WorkerTables& table = tables[worker];
-    table.distinct.resize(dims_);
-    table.pool_offset.resize(dims_);
+    table.keys.resize(dims_);
     table.index.resize(dims_);
     SharedBounds shared(states, rows_per_cell, reads);
     std::vector<double> lo(dims_), hi(dims_);
@@ -149,39 +143,29 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
           const auto k = std::int64_t(multi[d]);
           const MassInterval scale = per_dimension[d].scale_range(states.face(d, k), states.face(d, k + 1));
           const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
-          const auto found = table.index[d].emplace(key, std::uint32_t(table.distinct[d].size()));
+          const auto found = table.index[d].emplace(key, std::uint32_t(table.keys[d].size()));
           index_[r * dims_ + d] = found.first->second;
           if (slots[d]) *slots[d] = found.first->second;
-          if (!found.second) continue;
-          const DimensionBounds bounds = per_dimension[d].dimension_bounds(states, lo[d], hi[d], scale.lo, scale.hi);
-          table.distinct[d].push_back({bounds.first, bounds.cells.size(), nullptr, bounds.leave, bounds.cut});
-          table.pool_offset[d].push_back(table.pool.size());
-          table.pool.insert(table.pool.end(), bounds.cells.begin(), bounds.cells.end());
+          if (found.second) table.keys[d].push_back(key);
         }
       }
     }
   });
-  // One entry per distinct key over all workers: a later worker's entry that an earlier one has
-  // becomes that one's index.
-  distinct_.resize(dims_);
-  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash>> merged(dims_);
+  // One entry per distinct key over all workers (a later worker's key that an earlier one has
+  // takes that one's index), then the bounds of each once, on all workers.
+  std::vector<std::vector<BoundsKey>> keys(dims_);
+  std::vector<std::unordered_map<BoundsKey, std::uint32_t, BoundsKeyHash, BoundsKeyEqual>> merged(dims_);
   std::vector<std::vector<std::vector<std::uint32_t>>> global(threads, std::vector<std::vector<std::uint32_t>>(dims_));
   for (unsigned worker = 0; worker < threads; ++worker) {
-    WorkerTables& table = tables[worker];
-    for (std::size_t d = 0; d < dims_ && !table.distinct.empty(); ++d) {
-      global[worker][d].resize(table.distinct[d].size());
-      for (const auto& [key, local] : table.index[d]) {
-        const auto found = merged[d].emplace(key, std::uint32_t(distinct_[d].size()));
-        global[worker][d][local] = found.first->second;
-        if (!found.second) continue;
-        DimensionView view = table.distinct[d][local];
-        view.cells = table.pool.data() + table.pool_offset[d][local];
-        distinct_[d].push_back(view);
+    for (std::size_t d = 0; d < dims_ && !tables[worker].keys.empty(); ++d) {
+      for (const BoundsKey& key : tables[worker].keys[d]) {
+        const auto found = merged[d].emplace(key, std::uint32_t(keys[d].size()));
+        global[worker][d].push_back(found.first->second);
+        if (found.second) keys[d].push_back(key);
       }
     }
-    pool_size_ += table.pool.size();
-    pools_.push_back(std::move(table.pool));  // moving keeps the data where the views point
   }
+  compute_bounds(states, per_dimension, keys, threads);
   parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
       if (!needed[cell]) continue;
@@ -190,6 +174,34 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
     }
   });
   number_suffix_classes(needed);
+}
+
+void RowBounds::compute_bounds(const Grid& states, const std::vector<MassBounds>& per_dimension,
+                               const std::vector<std::vector<BoundsKey>>& keys, unsigned threads) {
+  std::vector<std::vector<DimensionBounds>> bounds(dims_);
+  for (std::size_t d = 0; d < dims_; ++d) {
+    bounds[d].resize(keys[d].size());
+    parallel_for(keys[d].size(), threads, [&](unsigned, std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i)
+        bounds[d][i] = per_dimension[d].dimension_bounds(states, keys[d][i].m_lo, keys[d][i].m_hi, keys[d][i].s_lo,
+                                                         keys[d][i].s_hi);
+    });
+    for (const DimensionBounds& one : bounds[d]) pool_size_ += one.cells.size();
+  }
+  // The views point into the pool once it is complete.
+  pool_.reserve(pool_size_);
+  distinct_.assign(dims_, {});
+  for (std::size_t d = 0; d < dims_; ++d)
+    for (const DimensionBounds& one : bounds[d]) {
+      distinct_[d].push_back({one.first, one.cells.size(), nullptr, one.leave, one.cut});
+      pool_.insert(pool_.end(), one.cells.begin(), one.cells.end());
+    }
+  std::size_t offset = 0;
+  for (std::size_t d = 0; d < dims_; ++d)
+    for (DimensionView& view : distinct_[d]) {
+      view.cells = pool_.data() + offset;
+      offset += view.count;
+    }
 }
 
 void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {

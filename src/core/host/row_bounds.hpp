@@ -54,7 +54,15 @@ class RowBounds {
   std::size_t intervals() const { return pool_size_; }
   std::size_t bytes() const;
 
+ /// What determines one dimension's bounds: the mean interval and the noise's scale range.
+  struct BoundsKey {
+    double m_lo, m_hi, s_lo, s_hi;
+  };
+
  private:
+  // The bounds of each distinct key, once, on `threads` workers; the pool and the views.
+  void compute_bounds(const Grid& states, const std::vector<MassBounds>& per_dimension,
+                      const std::vector<std::vector<BoundsKey>>& keys, unsigned threads);
   std::size_t dims_, inputs_, disturbances_;
   std::vector<std::uint32_t> index_;                 // [row * dims + d]; rows of unneeded cells: 0
   std::vector<std::vector<DimensionView>> distinct_;  // per dimension
@@ -62,7 +70,7 @@ class RowBounds {
   std::vector<std::size_t> suffix_classes_;           // per dimension (0 for d = 0)
   std::vector<std::vector<SuffixParts>> suffix_parts_;  // per dimension, per class
   void number_suffix_classes(const std::vector<bool>& needed);
-  std::vector<std::vector<MassInterval>> pools_;      // one per worker; views point into them
+  std::vector<MassInterval> pool_;  // the views point into it
   std::size_t pool_size_ = 0;
 };
 
