@@ -45,9 +45,10 @@ void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTa
 
 FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,
                                        cl_context context, const std::string& cache_dir, bool entry_per_item,
-                                       std::vector<EngineNote>& notes) {
+                                       bool rows_in_output_order, std::vector<EngineNote>& notes) {
   FactoredKernels kernels;
   kernels.shape = stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+  kernels.shape.rows_in_output_order = rows_in_output_order;
   notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
                    std::string("factored stages: ") +
                        (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"

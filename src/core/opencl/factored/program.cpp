@@ -3,6 +3,7 @@
 // kernel that takes min over disturbances and max over inputs from Q.
 #include "opencl/factored/program.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "amytiss/abstraction.hpp"
@@ -65,6 +66,28 @@ void scalar_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std:
     << "  out[entry] = accumulate ? out[entry] + sum : sum;\n}\n\n";
 }
 
+// SIMD rows: after the major digit (kept major: a team splits a stage's rows by it), the digits
+// that pick only masses (input stride 0) fastest, so that consecutive work-items of a group (run
+// one after another by a CPU thread) contract the same block of values with windows shifted by
+// a cell or so: the block stays in the core's cache instead of being fetched again after a pass
+// over every other block.
+void order_rows_by_window(std::vector<std::uint64_t>& radices, std::vector<std::uint64_t>& input_strides,
+                          std::vector<std::uint64_t>& tuple_strides, std::vector<std::uint64_t>& out_strides) {
+  std::vector<std::size_t> order(radices.size());
+  for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+  if (order.size() > 1)
+    std::stable_partition(order.begin() + 1, order.end(), [&](std::size_t j) { return input_strides[j] != 0; });
+  auto permuted = [&](const std::vector<std::uint64_t>& values) {
+    std::vector<std::uint64_t> result;
+    for (std::size_t j : order) result.push_back(values[j]);
+    return result;
+  };
+  radices = permuted(radices);
+  input_strides = permuted(input_strides);
+  tuple_strides = permuted(tuple_strides);
+  out_strides = permuted(out_strides);
+}
+
 // Entries along the vector digit share the tuple (masses, window) and read contiguous values.
 // SIMD devices: one work-item per row of the vector digit, LANES entries per vector load and FMA,
 // the row in chunks of LANES. SIMT devices: one work-item per entry (LANES 1), the vector digit
@@ -93,7 +116,9 @@ void vector_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std:
     out_strides.push_back(output_strides[j]);
   }
   const std::uint64_t lane_stride = output_strides[vector_digit];
-  if (!shape.row_per_item) {
+  if (shape.row_per_item) {
+    if (!shape.rows_in_output_order) order_rows_by_window(radices, input_strides, tuple_strides, out_strides);
+  } else {
     radices.push_back(chunks);
     input_strides.push_back(lanes);
     tuple_strides.push_back(0);

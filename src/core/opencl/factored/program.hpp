@@ -23,6 +23,9 @@ constexpr std::size_t kFactoredGroupSize = 64;
 /// work-items read neighbouring values. Same sums in the same order either way.
 struct StageShape {
   bool row_per_item = true;
+  /// Rows: false (the default) takes them window by window, the major output digit first;
+  /// true in output order (a team that splits a stage's rows by more than the major digit).
+  bool rows_in_output_order = false;
   /// Entries per vector: 8, 4 or 2 by the digit's radix for rows, 1 for entries.
   std::uint64_t lanes(std::uint64_t radix) const;
 };
