@@ -156,7 +156,8 @@ TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
 // Agreement of the factored sweep with the reference and the dense sweep: test_engine_matrix.cpp.
 
 TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
-  for (const std::string& yaml : {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml()}) {
+  for (const std::string& yaml :
+       {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml(), test_support::long_rows_yaml()}) {
     const Abstraction a = from_yaml(yaml);
     SynthesisOptions options = cpu_options();
     options.compute.sweep = SweepChoice::Factored;
