@@ -60,6 +60,8 @@ const Problem kProblems[] = {
     // The 3-d traffic ring on a coarser grid: few inputs, wide windows.
     {"traffic", test_support::traffic_yaml(0.4, 4)},
     {"robot_disturbance", test_support::robot_disturbance_yaml()},
+    // Rows of 101 entries along the first stage's vector digit.
+    {"long_rows", test_support::long_rows_yaml()},
     {"multiplicative",
      "name: multiplicative_small\n"
      "states: {lb: [-2, -2, -1], ub: [2, 2, 1], eta: [0.25, 0.25, 0.5]}\n"

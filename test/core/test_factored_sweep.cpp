@@ -11,6 +11,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "opencl/factored/plan.hpp"
+#include "opencl/factored/program.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/device.hpp"
 #include "execute.hpp"
@@ -156,7 +157,8 @@ TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
 // Agreement of the factored sweep with the reference and the dense sweep: test_engine_matrix.cpp.
 
 TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
-  for (const std::string& yaml : {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml()}) {
+  for (const std::string& yaml :
+       {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml(), test_support::long_rows_yaml()}) {
     const Abstraction a = from_yaml(yaml);
     SynthesisOptions options = cpu_options();
     options.compute.sweep = SweepChoice::Factored;
@@ -170,6 +172,32 @@ TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
     EXPECT_EQ(rows.values, entries.values) << a.config.name;
     EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name;
   }
+}
+
+TEST(FactoredSweep, RowsTakenWindowByWindowAreBitIdenticalToOneEntryPerWorkItem) {
+  // 54 cells per dimension and windows of 33: in output order the first two stages would read
+  // megabytes of values between two visits of a block, so SIMD devices take their rows window by
+  // window (the digits that pick only masses fastest).
+  const Abstraction a = from_yaml(traffic_yaml(0.15, 2));
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  const detail::StageShape by_window = detail::stage_shape_for(8);
+  detail::StageShape in_output_order = by_window;
+  in_output_order.rows_in_output_order = true;
+  ASSERT_NE(detail::factored_program_source(a, *plan, by_window),
+            detail::factored_program_source(a, *plan, in_output_order))
+      << "expected the rows of some stage taken window by window";
+  SynthesisOptions options = cpu_options();
+  options.compute.sweep = SweepChoice::Factored;
+  SynthesisReport rows_report, entries_report;
+  const Policy rows = detail::synthesize_opencl(a, options, &rows_report);
+  detail::OpenClEngineOptions entries_engine;
+  entries_engine.factored_entry_per_item = true;
+  const Policy entries = detail::synthesize_opencl(a, options, &entries_report, entries_engine);
+  ASSERT_TRUE(has_note(rows_report, "a row of entries per work-item"));
+  EXPECT_EQ(rows.values, entries.values);
+  EXPECT_EQ(rows.input_index, entries.input_index);
 }
 
 TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {

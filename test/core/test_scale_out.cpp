@@ -185,6 +185,23 @@ TEST(SubDevices, FactoredSweepIsBitIdenticalToOneDevice) {
   expect_identical(one, run(a, SweepChoice::Factored, kParts, nullptr, 0.5, true));
 }
 
+TEST(SubDevices, FactoredSweepSplitBeyondTheMajorDigitIsBitIdenticalToOneDevice) {
+  if (cpu_compute_units() < 2) GTEST_SKIP() << "the CPU device has one compute unit: nothing to split";
+  // x0 on two points: the stages' major digit has fewer values than the three devices, so their
+  // rows are split by every digit before the vector digit (the kernels keep rows in output order).
+  std::string yaml = chain_yaml();
+  yaml.replace(yaml.find("eta: [0.25, 0.25, 0.5]"), 22, "eta: [4.0, 0.05, 0.5]");
+  const Abstraction a = from_yaml(yaml);
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, 1e18, 1e18, &reason);
+  ASSERT_TRUE(plan) << reason;
+  const std::size_t fewest_devices_of_unequal = 3;  // the whole CPU and at least two parts
+  const auto parts = detail::stage_parts(plan->stages.front(), fewest_devices_of_unequal);
+  ASSERT_GT(parts.parts, 1u);
+  ASSERT_FALSE(parts.by_major_digit);
+  expect_identical(run(a, SweepChoice::Factored, {}), run(a, SweepChoice::Factored, kUnequal));
+}
+
 TEST(SubDevices, SlicedFactoredSweepIsBitIdenticalToOneDevice) {
   if (cpu_compute_units() < 2) GTEST_SKIP() << "the CPU device has one compute unit: nothing to split";
   const Abstraction a = from_yaml(chain_yaml());

@@ -240,6 +240,17 @@ inline std::string robot_disturbance_yaml() {
          "spec: {type: reach_avoid, horizon: 6, target: {lb: [5, 5], ub: [7, 7]}, avoid: {lb: [-2, -2], ub: [2, 2]}}\n";
 }
 
+/// Two coupled coordinates, x1 on 101 points: the factored sweep's first stage computes rows of
+/// 101 entries (13 vectors of 8 on a SIMD device, the last one partial).
+inline std::string long_rows_yaml() {
+  return "name: long_rows\n"
+         "states: {lb: [0, 0], ub: [4, 4], eta: [0.5, 0.04]}\n"
+         "inputs: {lb: [-1], ub: [1], eta: [1]}\n"
+         "dynamics: [\"0.7*x0 + 0.2*x1 + 0.5*u0\", \"0.3*x0 + 0.6*x1 + 0.4*u0\"]\n"
+         "noise: {type: additive, distribution: normal, covariance: [0.2, 0.1]}\n"
+         "spec: {type: safety, horizon: 4, safe: {lb: [0, 0], ub: [3.5, 3.5]}}\n";
+}
+
 /// Parses `root` and expects a ConfigError for `key` whose message contains `fragment`.
 inline void expect_error(const YAML::Node& root, const std::string& key, const std::string& fragment) {
   try {

@@ -69,11 +69,19 @@ std::vector<TeamMember> set_up_members(const Abstraction& a, const FactoredPlan&
   SynthesisReport& rep = reporter.report();
   std::vector<TeamMember> members(team.devices().size());
   auto phase_start = SteadyClock::now();
+  // A stage split by more than its major digit needs each part's rows as one range of work-items.
+  bool rows_in_output_order = false;
+  for (const FactoredStage& stage : plan.stages) {
+    const StageParts parts = stage_parts(stage, team.total_devices());
+    rows_in_output_order = rows_in_output_order || (parts.parts > 1 && !parts.by_major_digit);
+  }
   for (std::size_t i = 0; i < members.size(); ++i) {
     TeamDevice& device = team.devices()[i];
+    StageShape shape = factored_stage_shape(device.info, engine_options.factored_entry_per_item);
+    shape.rows_in_output_order = rows_in_output_order;
+    shape.states_in_q_order = false;  // the input choice is split by states
     members[i].kernels = build_factored_kernels(a, plan, device.info, device.session.context.get(),
-                                                engine_options.kernel_cache_dir,
-                                                engine_options.factored_entry_per_item, rep.notes);
+                                                engine_options.kernel_cache_dir, shape, rep.notes);
   }
   reporter.phase(PhaseKind::KernelBuild, "kernel build", seconds_since(phase_start));
   reporter.reached(Phase::Setup);

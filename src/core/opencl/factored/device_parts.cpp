@@ -43,11 +43,15 @@ void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTa
   check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
 }
 
+StageShape factored_stage_shape(const DeviceInfo& device, bool entry_per_item) {
+  return stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+}
+
 FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,
-                                       cl_context context, const std::string& cache_dir, bool entry_per_item,
+                                       cl_context context, const std::string& cache_dir, const StageShape& shape,
                                        std::vector<EngineNote>& notes) {
   FactoredKernels kernels;
-  kernels.shape = stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+  kernels.shape = shape;
   notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
                    std::string("factored stages: ") +
                        (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"

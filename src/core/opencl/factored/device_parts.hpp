@@ -35,8 +35,9 @@ StagePlacement stage_placement(const Abstraction& abstraction, const FactoredPla
 void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
                          const StagePlacement& placement);
 
-/// A device's program of the plan (stage kernels, choose_inputs) in the shape the device wants
-/// (entry_per_item: the SIMT shape whatever the device); a note says which shape.
+/// The shape `device` wants (entry_per_item: the SIMT shape whatever the device).
+StageShape factored_stage_shape(const DeviceInfo& device, bool entry_per_item);
+/// A device's program of the plan (stage kernels, choose_inputs) in `shape`; a note says which.
 struct FactoredKernels {
   StageShape shape;
   Program program;
@@ -45,7 +46,7 @@ struct FactoredKernels {
 };
 FactoredKernels build_factored_kernels(const Abstraction& abstraction, const FactoredPlan& plan,
                                        const DeviceInfo& device, cl_context context, const std::string& cache_dir,
-                                       bool entry_per_item, std::vector<EngineNote>& notes);
+                                       const StageShape& shape, std::vector<EngineNote>& notes);
 
 /// A device's buffers of the factored sweep: mass tables, roles, V (both arrays start at V_{T_d}),
 /// best inputs, Q and the two stage tensors.

@@ -23,6 +23,12 @@ constexpr std::size_t kFactoredGroupSize = 64;
 /// work-items read neighbouring values. Same sums in the same order either way.
 struct StageShape {
   bool row_per_item = true;
+  /// Rows: false (the default) takes them window by window, the major output digit first;
+  /// true in output order (a team that splits a stage's rows by more than the major digit).
+  bool rows_in_output_order = false;
+  /// Input choice: true (SIMD devices) takes a run of states per work-item in Q's order, false
+  /// one state per work-item (SIMT devices, and a team, which splits the choice by states).
+  bool states_in_q_order = false;
   /// Entries per vector: 8, 4 or 2 by the digit's radix for rows, 1 for entries.
   std::uint64_t lanes(std::uint64_t radix) const;
 };
@@ -30,6 +36,9 @@ StageShape stage_shape_for(unsigned native_double_width);
 
 /// Work-items of a stage's launch.
 std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& shape);
+
+/// Work-items of the input choice's launch.
+std::uint64_t choose_work_items(const Abstraction& abstraction, const StageShape& shape);
 
 /// OpenCL C of the plan: kernels stage0..stage{d-1} (one elimination each) and choose_inputs.
 std::string factored_program_source(const Abstraction& abstraction, const FactoredPlan& plan,

@@ -89,7 +89,7 @@ void FactoredStep::apply_resident(const double*, double* out, std::uint32_t* cho
     }
   }
   set_choose_arguments(kernels_.choose.get(), buffers_, 1 - current_);
-  launch(kernels_.choose.get(), n_states, plan_.stages.size());
+  launch(kernels_.choose.get(), choose_work_items(a_, kernels_.shape), plan_.stages.size());
   check(clEnqueueReadBuffer(run_.queue, buffers_.best_input.get(), CL_FALSE, 0, n_states * sizeof(cl_uint), chosen, 0,
                             nullptr, nullptr),
         "clEnqueueReadBuffer");
@@ -107,7 +107,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   SynthesisReport& report = reporter.report();
   auto phase_start = SteadyClock::now();
   FactoredKernels kernels = build_factored_kernels(a, plan, *run.device, run.context, run.kernel_cache_dir,
-                                                   run.entry_per_item, report.notes);
+                                                   factored_stage_shape(*run.device, run.entry_per_item), report.notes);
   reporter.phase(PhaseKind::KernelBuild, "kernel build", seconds_since(phase_start));
   reporter.reached(Phase::Setup);
 
