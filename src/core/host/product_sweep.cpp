@@ -175,7 +175,20 @@ void ProductSweep::prepare(const double* values) {
   const std::size_t dims = states_.dims();
   for (std::size_t d = dims; d-- > 1;) run_stage(d, d + 1 == dims ? values : tables_[d + 1].data());
   stage0_lines_ = dims == 1 ? values : tables_[1].data();
-  sort_lines(stage0_lines_, dims == 1 ? 1 : rows_.suffix_classes(1), states_.count(0), stage0_order_);
+  const std::size_t lines = dims == 1 ? 1 : rows_.suffix_classes(1), length = states_.count(0);
+  sort_lines(stage0_lines_, lines, length, stage0_order_);
+  rising_max_.resize(lines * length);
+  falling_max_.resize(lines * length);
+  parallel_for(lines, threads_, [&](unsigned, std::size_t first, std::size_t last) {
+    for (std::size_t start = first * length; start < last * length; start += length) {
+      rising_max_[start] = stage0_lines_[start];
+      for (std::size_t k = 1; k < length; ++k)
+        rising_max_[start + k] = std::max(rising_max_[start + k - 1], stage0_lines_[start + k]);
+      falling_max_[start + length - 1] = stage0_lines_[start + length - 1];
+      for (std::size_t k = length - 1; k-- > 0;)
+        falling_max_[start + k] = std::max(falling_max_[start + k + 1], stage0_lines_[start + k]);
+    }
+  });
 }
 
 double ProductSweep::expectation(std::size_t row) const {
@@ -195,18 +208,12 @@ double ProductSweep::upper_estimate(std::size_t row) const {
   const std::size_t length = states_.count(0);
   const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
   const DimensionView& window = rows_.distinct(0, rows_.bounds_index(row, 0));
-  const std::uint32_t* order = stage0_order_.order.data() + line;
+  // The window's largest value is at most the largest of the line up to its end and the largest
+  // from its start (equal to it where the line rises to one peak and falls). Leave is worth 0.
   const std::size_t first = std::size_t(window.first);
-  // The window's largest value: the last of its cells in the filling order (Lower), the first
-  // (Upper). Leave is worth 0.
-  double largest = 0.0;
-  for (std::size_t i = 0; i < length; ++i) {
-    const std::size_t position = order[bound_ == Bound::Lower ? length - 1 - i : i];
-    if (position - first < window.count) {
-      largest = stage0_lines_[line + position];
-      break;
-    }
-  }
+  const double largest = window.count == 0 ? 0.0
+                                            : std::min(rising_max_[line + first + window.count - 1],
+                                                       falling_max_[line + first]);
   // Any distribution's expectation is at most its largest value; the cut (worth 1 to the upper
   // bound) takes at most cut.hi.
   const double estimate = bound_ == Bound::Upper ? largest + window.cut.hi * (1.0 - largest) : largest;

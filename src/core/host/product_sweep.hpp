@@ -38,7 +38,7 @@ class ProductSweep {
   void prepare(const double* values);
   /// Stage 0 of `row` over the values of the last prepare(): the row's product bound.
   double expectation(std::size_t row) const;
-  /// At least expectation(row), from the largest value the row's stage 0 can take (a few reads):
+  /// At least expectation(row), from the largest value the row's stage 0 can take (two reads):
   /// an input whose estimate is not above the best value so far cannot be the maximiser.
   double upper_estimate(std::size_t row) const;
   /// What upper_estimate() adds for the outward rounding of expectation() (at most
@@ -64,6 +64,7 @@ class ProductSweep {
   LineOrder source_order_;  // the current stage's source lines' order
   LineOrder stage0_order_;  // stage 0's lines' order
   const double* stage0_lines_ = nullptr;
+  std::vector<double> rising_max_, falling_max_;  // per stage-0 line: largest up to / from each cell
 };
 
 /// One O-maximisation of robust_expectation() over a window of a line whose filling order is
