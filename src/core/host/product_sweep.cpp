@@ -200,10 +200,6 @@ double ProductSweep::expectation(std::size_t row) const {
                              bound_);
 }
 
-}  // namespace amytiss::detail
-
-namespace amytiss::detail {
-
 double ProductSweep::upper_estimate(std::size_t row) const {
   const std::size_t length = states_.count(0);
   const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
