@@ -148,6 +148,26 @@ TEST(IntervalBellman, OrthogonalLowerBoundIsAtLeastTheJointOne) {
   }
 }
 
+TEST(IntervalBellman, OneScratchServesGridsOfTheSameDimensions) {
+  // A scratch first used on one grid gives on another the bound a fresh scratch gives.
+  std::mt19937_64 generator(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  ProductScratch scratch;
+  for (const GridSpec& spec : {grid_spec({0, 0}, {5, 4}, {1, 1}), grid_spec({0, 0}, {3, 6}, {1, 1})}) {
+    const Grid grid(spec);
+    for (int trial = 0; trial < 20; ++trial) {
+      const std::vector<DimensionBounds> row = random_row(grid, trial % 2 == 1, generator);
+      std::vector<double> values(grid.size());
+      for (double& v : values) v = unit(generator);
+      std::vector<DimensionView> views;
+      for (const DimensionBounds& dimension : row) views.push_back(view_of(dimension));
+      for (Bound bound : {Bound::Lower, Bound::Upper})
+        EXPECT_EQ(product_expectation(grid, views.data(), values.data(), bound, scratch),
+                  product_expectation(grid, row, values.data(), bound));
+    }
+  }
+}
+
 TEST(IntervalBellman, OneDimensionOrthogonalEqualsJoint) {
   std::mt19937_64 generator(13);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

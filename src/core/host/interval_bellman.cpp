@@ -176,7 +176,9 @@ double product_expectation(const Grid& states, const DimensionView* dimensions, 
                            ProductScratch& scratch) {
   const std::size_t dims = states.dims();
   require(dims > 0, "a state grid with dimensions");
-  if (scratch.counts.size() != dims) {
+  bool same_grid = scratch.counts.size() == dims;
+  for (std::size_t d = 0; d < dims && same_grid; ++d) same_grid = scratch.counts[d] == states.count(d);
+  if (!same_grid) {
     scratch.stages.resize(dims);
     scratch.counts.resize(dims);
     scratch.prefixes.resize(dims);
