@@ -156,21 +156,32 @@ TEST(FactoredPlan, MassTablesAreTheNoiseModelsKeptMasses) {
 
 // Agreement of the factored sweep with the reference and the dense sweep: test_engine_matrix.cpp.
 
+// The factored sweep of `a` on pocl in the device's shape (a row of entries per work-item) and
+// with one entry per work-item (the GPU's shape).
+struct BothShapes {
+  SynthesisReport rows_report, entries_report;
+  Policy rows, entries;
+};
+BothShapes run_both_shapes(const Abstraction& a) {
+  SynthesisOptions options = cpu_options();
+  options.compute.sweep = SweepChoice::Factored;
+  BothShapes both;
+  both.rows = detail::synthesize_opencl(a, options, &both.rows_report);
+  detail::OpenClEngineOptions entries_engine;
+  entries_engine.factored_entry_per_item = true;
+  both.entries = detail::synthesize_opencl(a, options, &both.entries_report, entries_engine);
+  return both;
+}
+
 TEST(FactoredSweep, GpuShapeOneEntryPerWorkItemIsBitIdenticalToRowsOfVectors) {
   for (const std::string& yaml :
        {traffic_yaml(0.4, 3), robot_disturbance_yaml(), multiplicative_yaml(), test_support::long_rows_yaml()}) {
     const Abstraction a = from_yaml(yaml);
-    SynthesisOptions options = cpu_options();
-    options.compute.sweep = SweepChoice::Factored;
-    SynthesisReport rows_report, entries_report;
-    const Policy rows = detail::synthesize_opencl(a, options, &rows_report);
-    detail::OpenClEngineOptions entries_engine;
-    entries_engine.factored_entry_per_item = true;
-    const Policy entries = detail::synthesize_opencl(a, options, &entries_report, entries_engine);
-    EXPECT_TRUE(has_note(rows_report, "a row of entries per work-item"));
-    EXPECT_TRUE(has_note(entries_report, "one entry per work-item"));
-    EXPECT_EQ(rows.values, entries.values) << a.config.name;
-    EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name;
+    const BothShapes both = run_both_shapes(a);
+    EXPECT_TRUE(has_note(both.rows_report, "a row of entries per work-item"));
+    EXPECT_TRUE(has_note(both.entries_report, "one entry per work-item"));
+    EXPECT_EQ(both.rows.values, both.entries.values) << a.config.name;
+    EXPECT_EQ(both.rows.input_index, both.entries.input_index) << a.config.name;
   }
 }
 
@@ -188,16 +199,10 @@ TEST(FactoredSweep, RowsTakenWindowByWindowAreBitIdenticalToOneEntryPerWorkItem)
   ASSERT_NE(detail::factored_program_source(a, *plan, by_window),
             detail::factored_program_source(a, *plan, in_output_order))
       << "expected the rows of some stage taken window by window";
-  SynthesisOptions options = cpu_options();
-  options.compute.sweep = SweepChoice::Factored;
-  SynthesisReport rows_report, entries_report;
-  const Policy rows = detail::synthesize_opencl(a, options, &rows_report);
-  detail::OpenClEngineOptions entries_engine;
-  entries_engine.factored_entry_per_item = true;
-  const Policy entries = detail::synthesize_opencl(a, options, &entries_report, entries_engine);
-  ASSERT_TRUE(has_note(rows_report, "a row of entries per work-item"));
-  EXPECT_EQ(rows.values, entries.values);
-  EXPECT_EQ(rows.input_index, entries.input_index);
+  const BothShapes both = run_both_shapes(a);
+  ASSERT_TRUE(has_note(both.rows_report, "a row of entries per work-item"));
+  EXPECT_EQ(both.rows.values, both.entries.values);
+  EXPECT_EQ(both.rows.input_index, both.entries.input_index);
 }
 
 TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
