@@ -205,21 +205,24 @@ void RowBounds::compute_bounds(const Grid& states, const std::vector<MassBounds>
 }
 
 void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {
-  // class_d(row) numbers the pairs (bounds of d, class_{d+1}(row)), the last dimension's class
-  // being its bounds' index.
-  suffix_class_.assign(index_.size(), 0);
+  // class_d(row) numbers the pairs (bounds of d, class_{d+1}(row)); the last dimension's class is
+  // its bounds' index.
   suffix_classes_.assign(dims_, 0);
   suffix_parts_.assign(dims_, {});
-  const std::size_t rows_per_cell = inputs_ * disturbances_;
-  for (std::size_t d = dims_; d-- > 1;) {
+  if (dims_ < 2) return;
+  suffix_classes_[dims_ - 1] = distinct_[dims_ - 1].size();
+  for (std::uint32_t b = 0; b < distinct_[dims_ - 1].size(); ++b) suffix_parts_[dims_ - 1].push_back({b, 0});
+  const std::size_t rows_per_cell = inputs_ * disturbances_, middle = dims_ - 2;
+  suffix_class_.assign(needed.size() * rows_per_cell * middle, 0);
+  for (std::size_t d = dims_ - 1; d-- > 1;) {
     std::unordered_map<std::uint64_t, std::uint32_t> classes;
     for (std::size_t cell = 0; cell < needed.size(); ++cell) {
       if (!needed[cell]) continue;
       for (std::size_t r = cell * rows_per_cell; r < (cell + 1) * rows_per_cell; ++r) {
-        const std::uint64_t next = d + 1 < dims_ ? suffix_class_[r * dims_ + d + 1] : 0;
+        const std::uint64_t next = suffix_class(r, d + 1);
         const std::uint64_t pair = (next << 32) | index_[r * dims_ + d];
         const auto found = classes.emplace(pair, std::uint32_t(classes.size()));
-        suffix_class_[r * dims_ + d] = found.first->second;
+        suffix_class_[r * middle + d - 1] = found.first->second;
         if (found.second) suffix_parts_[d].push_back({index_[r * dims_ + d], std::uint32_t(next)});
       }
     }
@@ -230,7 +233,7 @@ void RowBounds::number_suffix_classes(const std::vector<bool>& needed) {
 std::size_t RowBounds::bytes() const {
   std::size_t views = 0;
   for (const auto& table : distinct_) views += table.size();
-  return 2 * index_.size() * sizeof(std::uint32_t) + views * sizeof(DimensionView) + pool_size_ * sizeof(MassInterval);
+  return (index_.size() + suffix_class_.size()) * sizeof(std::uint32_t) + views * sizeof(DimensionView) + pool_size_ * sizeof(MassInterval);
 }
 
 }  // namespace amytiss::detail

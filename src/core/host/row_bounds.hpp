@@ -42,7 +42,9 @@ class RowBounds {
   /// The class of the row's bounds of dimensions d..dims-1 (1 <= d < dims): rows of one class
   /// have the same bounds in all of them, so the product set's stages d..dims-1 give them the same
   /// results on the same window line. Classes are numbered 0..suffix_classes(d)-1.
-  std::uint32_t suffix_class(std::size_t row, std::size_t d) const { return suffix_class_[row * dims_ + d]; }
+  std::uint32_t suffix_class(std::size_t row, std::size_t d) const {
+    return d + 1 == dims_ ? index_[row * dims_ + d] : suffix_class_[row * (dims_ - 2) + d - 1];
+  }
   std::size_t suffix_classes(std::size_t d) const { return suffix_classes_[d]; }
   /// What suffix class `suffix_class` of dimension d (1 <= d < dims) is made of: the index of its
   /// bounds of dimension d and its class of dimension d + 1 (0 for the last dimension).
@@ -66,7 +68,9 @@ class RowBounds {
   std::size_t dims_, inputs_, disturbances_;
   std::vector<std::uint32_t> index_;                 // [row * dims + d]; rows of unneeded cells: 0
   std::vector<std::vector<DimensionView>> distinct_;  // per dimension
-  std::vector<std::uint32_t> suffix_class_;           // [row * dims + d], d >= 1
+  // [row * (dims - 2) + d - 1] for 1 <= d < dims - 1; the last dimension's classes are its
+  // bounds' indices.
+  std::vector<std::uint32_t> suffix_class_;
   std::vector<std::size_t> suffix_classes_;           // per dimension (0 for d = 0)
   std::vector<std::vector<SuffixParts>> suffix_parts_;  // per dimension, per class
   void number_suffix_classes(const std::vector<bool>& needed);
