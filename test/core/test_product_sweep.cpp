@@ -1,7 +1,9 @@
 // The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
 // ties, the leave and cut outcomes); the sweep gives product_expectation()'s row by row, and its
-// estimate for the input choice is never below it; rows that share a mean box through what the map reads get the bounds they would compute themselves.
+// estimate for the input choice is never below it, and sweeps that share buffers give what each
+// gives alone; rows that share a mean box through what the map reads get the bounds they would
+// compute themselves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -126,24 +128,56 @@ RowBounds bounds_of(const Abstraction& a, const ImageEnclosure& enclosure,
                    enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, 2, reads);
 }
 
+// Values on a few levels, and values that are 0 but on the grid's first slice along dimension 0
+// (rows whose windows miss it see only zeros: the estimate's exact 0).
+std::vector<std::vector<double>> test_values(const Grid& states) {
+  std::mt19937 random(kSeed);
+  std::vector<double> sparse(states.size(), 0.0);
+  std::fill(sparse.begin(), sparse.begin() + std::ptrdiff_t(states.size() / states.count(0)), 1.0);
+  return {random_line(random, states.size()), sparse};
+}
+
 TEST(ProductSweep, SweepGivesTheRowByRowProductBound) {
   const Abstraction a = from_yaml(system_3d_yaml());
   const ImageEnclosure enclosure(a.config);
   const RowBounds rows = bounds_of(a, enclosure, bounds_reads(a));
-  std::mt19937 random(kSeed);
-  const std::vector<double> values = random_line(random, a.states.size());
   std::vector<DimensionView> views(a.states.dims());
-  for (Bound bound : {Bound::Lower, Bound::Upper}) {
-    ProductSweep sweep(a.states, rows, bound, 2);
-    sweep.prepare(values.data());
-    ProductScratch scratch;
-    for (std::size_t row = 0; row < a.triples(); ++row) {
-      rows.dimensions(row, views.data());
-      const double expectation = sweep.expectation(row);
-      ASSERT_EQ(expectation, product_expectation(a.states, views.data(), values.data(), bound, scratch))
-          << "row " << row;
-      // What the input choice skips by: never below the row's bound.
-      ASSERT_GE(sweep.upper_estimate(row), expectation) << "row " << row;
+  std::size_t zero_estimates = 0;
+  for (const std::vector<double>& values : test_values(a.states)) {
+    for (Bound bound : {Bound::Lower, Bound::Upper}) {
+      ProductSweep sweep(a.states, rows, bound, 2);
+      sweep.prepare(values.data());
+      ProductScratch scratch;
+      for (std::size_t row = 0; row < a.triples(); ++row) {
+        rows.dimensions(row, views.data());
+        const double expectation = sweep.expectation(row);
+        ASSERT_EQ(expectation, product_expectation(a.states, views.data(), values.data(), bound, scratch))
+            << "row " << row;
+        // What the input choice skips by: never below the row's bound.
+        ASSERT_GE(sweep.upper_estimate(row), expectation) << "row " << row;
+        zero_estimates += sweep.upper_estimate(row) == 0.0;
+      }
+    }
+  }
+  EXPECT_GT(zero_estimates, 0u) << "no window of zeros: the sparse values do not test the exact 0";
+}
+
+TEST(ProductSweep, SweepsSharingBuffersGiveWhatEachGivesAlone) {
+  const Abstraction a = from_yaml(system_3d_yaml());
+  const ImageEnclosure enclosure(a.config);
+  const RowBounds rows = bounds_of(a, enclosure, bounds_reads(a));
+  const auto buffers = std::make_shared<SweepBuffers>();
+  ProductSweep lower(a.states, rows, Bound::Lower, 2, buffers), upper(a.states, rows, Bound::Upper, 2, buffers);
+  ProductSweep lower_alone(a.states, rows, Bound::Lower, 2), upper_alone(a.states, rows, Bound::Upper, 2);
+  // As the backward driver runs them: one bound's prepare() and rows, then the other's.
+  for (const std::vector<double>& values : test_values(a.states)) {
+    for (auto [shared, alone] : {std::pair{&lower, &lower_alone}, std::pair{&upper, &upper_alone}}) {
+      shared->prepare(values.data());
+      alone->prepare(values.data());
+      for (std::size_t row = 0; row < a.triples(); ++row) {
+        ASSERT_EQ(shared->expectation(row), alone->expectation(row)) << "row " << row;
+        ASSERT_EQ(shared->upper_estimate(row), alone->upper_estimate(row)) << "row " << row;
+      }
     }
   }
 }

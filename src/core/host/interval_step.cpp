@@ -3,17 +3,35 @@
 #include <limits>
 
 namespace amytiss::detail {
+namespace {
+
+// The cells with dimension 0 varying fastest: neighbours in this order share their coordinates
+// of dimensions 1.., hence usually the suffix classes of their rows and the stage-0 lines the
+// sweep reads for them, which then stay in cache.
+std::vector<std::uint32_t> first_dimension_fastest(const Grid& states) {
+  std::vector<std::uint32_t> order(states.size());
+  std::vector<std::size_t> multi(states.dims(), 0);
+  for (std::size_t visit = 0; visit < order.size(); ++visit) {
+    order[visit] = std::uint32_t(states.flat_index(multi.data()));
+    for (std::size_t d = 0; d < multi.size() && ++multi[d] == states.count(d); ++d) multi[d] = 0;
+  }
+  return order;
+}
+
+}  // namespace
 
 IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles,
-                           Bound bound, AmbiguitySet set, unsigned threads)
+                           Bound bound, AmbiguitySet set, unsigned threads,
+                           std::shared_ptr<SweepBuffers> sweep_buffers)
     : a_(abstraction), rows_(rows), roles_(std::move(roles)), bound_(bound), set_(set), threads_(threads) {
   const std::size_t dims = a_.states.dims();
   stage_caches_.resize(dims);
   stage_cache_entries_.assign(dims, 0);
   if (set_ != AmbiguitySet::Product) return;
   if (ProductSweep::pays(a_.states, rows_, a_.triples())) {
-    sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_);
-    last_choice_.assign(a_.states.size(), 0);
+    sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_, std::move(sweep_buffers));
+    last_choice_.assign(a_.states.size(), kNoChoice);
+    visit_order_ = first_dimension_fastest(a_.states);
     return;
   }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
@@ -68,13 +86,27 @@ double IntervalStep::estimate(std::size_t cell, std::size_t input) const {
   return estimate;
 }
 
+std::size_t IntervalStep::most_promising(std::size_t cell) const {
+  std::size_t most_promising = 0;
+  double highest = -std::numeric_limits<double>::infinity();
+  for (std::size_t u = 0; u < a_.inputs.size(); ++u) {
+    const double most = estimate(cell, u);
+    if (most > highest) {
+      highest = most;
+      most_promising = u;
+    }
+  }
+  return most_promising;
+}
+
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   reset_stage_caches();
   if (sweep_) sweep_->prepare(in);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);
-    for (std::size_t cell = first; cell < last; ++cell) {
+    for (std::size_t visit = first; visit < last; ++visit) {
+      const std::size_t cell = visit_order_.empty() ? visit : visit_order_[visit];
       chosen[cell] = 0;
       if (roles_[cell] != CellRole::Free) {
         out[cell] = a_.terminal_value(roles_[cell]);
@@ -83,7 +115,8 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
       // The maximiser with the lowest index. With the sweep, the input chosen at the previous step
       // goes first, and an input whose estimate cannot beat the best so far is skipped: it can
       // only tie with it when its index is lower, so those need a strictly lower estimate.
-      const std::size_t seed = sweep_ ? last_choice_[cell] : 0;
+      // Before any choice, the input with the highest estimate goes first.
+      const std::size_t seed = !sweep_ ? 0 : last_choice_[cell] != kNoChoice ? last_choice_[cell] : most_promising(cell);
       double best = worst_case(cell, seed, in, scratch);
       chosen[cell] = std::uint32_t(seed);
       for (std::size_t u = 0; u < a_.inputs.size(); ++u) {

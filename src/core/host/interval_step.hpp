@@ -22,8 +22,10 @@ class IntervalStep : public BellmanStep {
   /// At most this many entries (8 bytes each) in the caches of the product set's stages.
   static constexpr std::size_t kMaxStageCacheEntries = std::size_t(1) << 24;
   /// `roles`: the bound's cell roles (robust_cell_roles()); `rows` must hold every Free cell's rows.
+  /// `sweep_buffers`: shared with the steps over the same rows that never run at the same time as
+  /// this one (ProductSweep); null: its own.
   IntervalStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles, Bound bound,
-               AmbiguitySet set, unsigned threads);
+               AmbiguitySet set, unsigned threads, std::shared_ptr<SweepBuffers> sweep_buffers = nullptr);
   void apply(const double* in, double* out, std::uint32_t* chosen) override;
   /// The step of one stationary controller (certification): out(x) = min_w of the bound's
   /// expectation with input controller[x]; fixed cells hold their role's value.
@@ -37,6 +39,8 @@ class IntervalStep : public BellmanStep {
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
   // At least worst_case() (sweep only): min over disturbances of ProductSweep::upper_estimate().
   double estimate(std::size_t cell, std::size_t input) const;
+  // The input with the highest estimate (sweep only), the lowest index among equals.
+  std::size_t most_promising(std::size_t cell) const;
   void reset_stage_caches();
   void use_stage_caches(ProductScratch& scratch) const;
   const Abstraction& a_;
@@ -51,7 +55,9 @@ class IntervalStep : public BellmanStep {
   std::vector<std::size_t> stage_cache_entries_;
   // The product set over whole tables where it pays (host/product_sweep.hpp); then no caches.
   std::unique_ptr<ProductSweep> sweep_;
+  static constexpr std::uint32_t kNoChoice = ~std::uint32_t(0);
   std::vector<std::uint32_t> last_choice_;  // per cell, the input apply() chose last (sweep only)
+  std::vector<std::uint32_t> visit_order_;  // the order apply() visits the cells in (sweep only)
 };
 
 }  // namespace amytiss::detail

@@ -119,18 +119,16 @@ bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t r
   return entries <= kMaxTableEntries;
 }
 
-ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads)
-    : states_(states), rows_(rows), bound_(bound), threads_(threads) {
+ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads,
+                           std::shared_ptr<SweepBuffers> buffers)
+    : states_(states), rows_(rows), bound_(bound), threads_(threads), buffers_(std::move(buffers)) {
+  if (!buffers_) buffers_ = std::make_shared<SweepBuffers>();
   const std::size_t dims = states.dims();
   prefixes_.assign(dims, 1);
-  tables_.resize(dims);
   sums_.resize(dims);
   for (std::size_t d = 0; d < dims; ++d)
     for (std::uint32_t b = 0; b < rows.distinct_bounds(d); ++b) sums_[d].push_back(window_sums(rows.distinct(d, b)));
-  for (std::size_t d = 1; d < dims; ++d) {
-    prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
-    tables_[d].resize(prefixes_[d] * rows.suffix_classes(d));
-  }
+  for (std::size_t d = 1; d < dims; ++d) prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
 }
 
 void ProductSweep::sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const {
@@ -154,8 +152,11 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
   const std::size_t length = states_.count(d), prefixes = prefixes_[d];
   const std::size_t source_classes = d + 1 == states_.dims() ? 1 : rows_.suffix_classes(d + 1);
   // Line (next, p) of the source: the values at prefix p * length + k of class next.
-  sort_lines(source, source_classes * prefixes, length, source_order_);
-  double* table = tables_[d].data();
+  LineOrder& source_order = buffers_->source_order;
+  sort_lines(source, source_classes * prefixes, length, source_order);
+  std::vector<double>& stage = buffers_->tables[d];
+  stage.resize(prefixes * rows_.suffix_classes(d));
+  double* table = stage.data();
   parallel_for(rows_.suffix_classes(d), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     for (std::size_t suffix_class = first; suffix_class < last; ++suffix_class) {
       const RowBounds::SuffixParts parts = rows_.suffix_parts(d, std::uint32_t(suffix_class));
@@ -164,7 +165,7 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
       for (std::size_t p = 0; p < prefixes; ++p) {
         const std::size_t line = (std::size_t(parts.next) * prefixes + p) * length;
         table[suffix_class * prefixes + p] =
-            ordered_expectation(source + line, source_order_.order.data() + line, source_order_.rank.data() + line,
+            ordered_expectation(source + line, source_order.order.data() + line, source_order.rank.data() + line,
                                 length, window, sums, bound_);
       }
     }
@@ -173,20 +174,24 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
 
 void ProductSweep::prepare(const double* values) {
   const std::size_t dims = states_.dims();
-  for (std::size_t d = dims; d-- > 1;) run_stage(d, d + 1 == dims ? values : tables_[d + 1].data());
-  stage0_lines_ = dims == 1 ? values : tables_[1].data();
+  std::vector<std::vector<double>>& tables = buffers_->tables;
+  tables.resize(dims);
+  for (std::size_t d = dims; d-- > 1;) run_stage(d, d + 1 == dims ? values : tables[d + 1].data());
+  stage0_lines_ = dims == 1 ? values : tables[1].data();
   const std::size_t lines = dims == 1 ? 1 : rows_.suffix_classes(1), length = states_.count(0);
-  sort_lines(stage0_lines_, lines, length, stage0_order_);
-  rising_max_.resize(lines * length);
-  falling_max_.resize(lines * length);
+  sort_lines(stage0_lines_, lines, length, buffers_->stage0_order);
+  std::vector<double>& rising = buffers_->rising_max;
+  std::vector<double>& falling = buffers_->falling_max;
+  rising.resize(lines * length);
+  falling.resize(lines * length);
   parallel_for(lines, threads_, [&](unsigned, std::size_t first, std::size_t last) {
     for (std::size_t start = first * length; start < last * length; start += length) {
-      rising_max_[start] = stage0_lines_[start];
+      rising[start] = stage0_lines_[start];
       for (std::size_t k = 1; k < length; ++k)
-        rising_max_[start + k] = std::max(rising_max_[start + k - 1], stage0_lines_[start + k]);
-      falling_max_[start + length - 1] = stage0_lines_[start + length - 1];
+        rising[start + k] = std::max(rising[start + k - 1], stage0_lines_[start + k]);
+      falling[start + length - 1] = stage0_lines_[start + length - 1];
       for (std::size_t k = length - 1; k-- > 0;)
-        falling_max_[start + k] = std::max(falling_max_[start + k + 1], stage0_lines_[start + k]);
+        falling[start + k] = std::max(falling[start + k + 1], stage0_lines_[start + k]);
     }
   });
 }
@@ -195,9 +200,9 @@ double ProductSweep::expectation(std::size_t row) const {
   const std::size_t length = states_.count(0);
   const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
   const std::uint32_t bounds = rows_.bounds_index(row, 0);
-  return ordered_expectation(stage0_lines_ + line, stage0_order_.order.data() + line,
-                             stage0_order_.rank.data() + line, length, rows_.distinct(0, bounds), sums_[0][bounds],
-                             bound_);
+  const LineOrder& sorted = buffers_->stage0_order;
+  return ordered_expectation(stage0_lines_ + line, sorted.order.data() + line, sorted.rank.data() + line, length,
+                             rows_.distinct(0, bounds), sums_[0][bounds], bound_);
 }
 
 double ProductSweep::upper_estimate(std::size_t row) const {
@@ -208,12 +213,14 @@ double ProductSweep::upper_estimate(std::size_t row) const {
   // from its start (equal to it where the line rises to one peak and falls). Leave is worth 0.
   const std::size_t first = std::size_t(window.first);
   const double largest = window.count == 0 ? 0.0
-                                            : std::min(rising_max_[line + first + window.count - 1],
-                                                       falling_max_[line + first]);
+                                            : std::min(buffers_->rising_max[line + first + window.count - 1],
+                                                       buffers_->falling_max[line + first]);
   // Any distribution's expectation is at most its largest value; the cut (worth 1 to the upper
-  // bound) takes at most cut.hi.
+  // bound) takes at most cut.hi. expectation() clamps to [0, 1], and the lower bound of a window
+  // of zeros is exactly 0 (every term is a product with 0, the rounding is clamped away).
+  if (bound_ == Bound::Lower && largest == 0.0) return 0.0;
   const double estimate = bound_ == Bound::Upper ? largest + window.cut.hi * (1.0 - largest) : largest;
-  return estimate + kEstimateMargin;
+  return std::min(1.0, estimate + kEstimateMargin);
 }
 
 }  // namespace amytiss::detail

@@ -8,6 +8,7 @@
 // with the stage caches of host/interval_step.hpp.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "amytiss/grid.hpp"
@@ -23,6 +24,23 @@ struct WindowSums {
 };
 WindowSums window_sums(const DimensionView& window);
 
+/// Sort order of every line of `count` lines of `length` values: order[line * length + r] is the
+/// position of the r-th value of the line in a bound's filling order (stable), rank the inverse.
+struct LineOrder {
+  std::vector<std::uint32_t> order, rank;
+};
+
+/// What one ProductSweep::prepare() builds and its expectations read: the stage tables, the lines'
+/// sort orders and stage 0's running maxima. Every prepare() rebuilds all of it, so sweeps that
+/// never run at the same time (a step's lower and upper bound) can share one and touch half the
+/// memory.
+struct SweepBuffers {
+  std::vector<std::vector<double>> tables;  // per dimension d >= 1: [suffix class][prefix]
+  LineOrder source_order;                   // the current stage's source lines' order
+  LineOrder stage0_order;                   // stage 0's lines' order
+  std::vector<double> rising_max, falling_max;  // per stage-0 line: largest up to / from each cell
+};
+
 class ProductSweep {
  public:
   /// At most this many table entries (a double and a 32-bit position each).
@@ -32,7 +50,10 @@ class ProductSweep {
   /// is at most 4 times as long as its average window (a scan reads the whole line). Otherwise
   /// product_expectation() row by row is the cheaper way to the same results.
   static bool pays(const Grid& states, const RowBounds& rows, std::size_t row_count);
-  ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads);
+  /// `buffers`: shared with sweeps of the same rows that never run at the same time as this
+  /// one; null: its own.
+  ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads,
+               std::shared_ptr<SweepBuffers> buffers = nullptr);
   /// Stages dims-1..1 over `values` (one per state cell, flat) and the sort order of stage 0's
   /// lines.
   void prepare(const double* values);
@@ -48,23 +69,15 @@ class ProductSweep {
  private:
   // Stage d's table, [suffix class][prefix], from its source's lines.
   void run_stage(std::size_t d, const double* source);
-  // Sort order of every line of `count` lines of `length` values: order[line * length + r] is the
-  // position of the r-th value of the line in the bound's filling order (stable), rank the inverse.
-  struct LineOrder {
-    std::vector<std::uint32_t> order, rank;
-  };
   void sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const;
   const Grid& states_;
   const RowBounds& rows_;
   Bound bound_;
   unsigned threads_;
   std::vector<std::size_t> prefixes_;        // cells of dimensions 0..d-1
-  std::vector<std::vector<double>> tables_;  // per dimension d >= 1
   std::vector<std::vector<WindowSums>> sums_;  // per dimension and distinct bounds
-  LineOrder source_order_;  // the current stage's source lines' order
-  LineOrder stage0_order_;  // stage 0's lines' order
+  std::shared_ptr<SweepBuffers> buffers_;
   const double* stage0_lines_ = nullptr;
-  std::vector<double> rising_max_, falling_max_;  // per stage-0 line: largest up to / from each cell
 };
 
 /// One O-maximisation of robust_expectation() over a window of a line whose filling order is

@@ -44,8 +44,10 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
            (set == AmbiguitySet::Joint ? "joint interval MDP" : "product interval MDP") + " on " +
            std::to_string(threads) + " host thread" + (threads == 1 ? "" : "s")});
   reporter.reached(Phase::Construction);
-  IntervalStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads);
-  IntervalStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads);
+  // The backward driver runs the two bounds' steps one after the other: one set of sweep buffers.
+  const auto sweep_buffers = std::make_shared<SweepBuffers>();
+  IntervalStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads, sweep_buffers);
+  IntervalStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads, sweep_buffers);
   return run_backward_bounds(a, lower, upper, reporter);
 }
 
