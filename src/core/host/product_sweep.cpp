@@ -129,6 +129,11 @@ ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound boun
   for (std::size_t d = 0; d < dims; ++d)
     for (std::uint32_t b = 0; b < rows.distinct_bounds(d); ++b) sums_[d].push_back(window_sums(rows.distinct(d, b)));
   for (std::size_t d = 1; d < dims; ++d) prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
+  for (std::uint32_t b = 0; b < rows.distinct_bounds(0); ++b) {
+    const DimensionView& window = rows.distinct(0, b);
+    estimate_windows_.push_back({std::int32_t(window.first), std::int32_t(window.first + std::int64_t(window.count)) - 1,
+                                 window.cut.hi});
+  }
 }
 
 void ProductSweep::sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const {
@@ -208,18 +213,18 @@ double ProductSweep::expectation(std::size_t row) const {
 double ProductSweep::upper_estimate(std::size_t row) const {
   const std::size_t length = states_.count(0);
   const std::size_t line = (states_.dims() == 1 ? 0 : rows_.suffix_class(row, 1)) * length;
-  const DimensionView& window = rows_.distinct(0, rows_.bounds_index(row, 0));
+  const EstimateWindow& window = estimate_windows_[rows_.bounds_index(row, 0)];
   // The window's largest value is at most the largest of the line up to its end and the largest
   // from its start (equal to it where the line rises to one peak and falls). Leave is worth 0.
-  const std::size_t first = std::size_t(window.first);
-  const double largest = window.count == 0 ? 0.0
-                                            : std::min(buffers_->rising_max[line + first + window.count - 1],
-                                                       buffers_->falling_max[line + first]);
+  const double largest = window.last < window.first
+                             ? 0.0
+                             : std::min(buffers_->rising_max[line + std::size_t(window.last)],
+                                        buffers_->falling_max[line + std::size_t(window.first)]);
   // Any distribution's expectation is at most its largest value; the cut (worth 1 to the upper
   // bound) takes at most cut.hi. expectation() clamps to [0, 1], and the lower bound of a window
   // of zeros is exactly 0 (every term is a product with 0, the rounding is clamped away).
   if (bound_ == Bound::Lower && largest == 0.0) return 0.0;
-  const double estimate = bound_ == Bound::Upper ? largest + window.cut.hi * (1.0 - largest) : largest;
+  const double estimate = bound_ == Bound::Upper ? largest + window.cut_hi * (1.0 - largest) : largest;
   return std::min(1.0, estimate + kEstimateMargin);
 }
 

@@ -76,6 +76,13 @@ class ProductSweep {
   unsigned threads_;
   std::vector<std::size_t> prefixes_;        // cells of dimensions 0..d-1
   std::vector<std::vector<WindowSums>> sums_;  // per dimension and distinct bounds
+  // What upper_estimate() reads of stage 0's distinct bounds, packed to stay in cache: the window's
+  // cells first..last (none when last < first) and the cut's largest mass.
+  struct EstimateWindow {
+    std::int32_t first, last;
+    double cut_hi;
+  };
+  std::vector<EstimateWindow> estimate_windows_;
   std::shared_ptr<SweepBuffers> buffers_;
   const double* stage0_lines_ = nullptr;
 };

@@ -95,9 +95,14 @@ double MassBounds::upper_mass(double za, double zb) const {
   return std::min(1.0, round_up(standard_mass(za, zb) + mass_error_));
 }
 
-MassInterval MassBounds::at_mean(double a, double b, double m, double s) const {
+double MassBounds::lower_at_mean(double a, double b, double m, double s) const {
   const MassInterval za = ratio_range(a - m, a - m, s, s), zb = ratio_range(b - m, b - m, s, s);
-  return {lower_mass(za.hi, zb.lo), upper_mass(za.lo, zb.hi)};
+  return lower_mass(za.hi, zb.lo);
+}
+
+double MassBounds::upper_at_mean(double a, double b, double m, double s) const {
+  const MassInterval za = ratio_range(a - m, a - m, s, s), zb = ratio_range(b - m, b - m, s, s);
+  return upper_mass(za.lo, zb.hi);
 }
 
 MassInterval MassBounds::cdf_bounds(double a, double b, double m_lo, double m_hi, double s_lo, double s_hi,
@@ -132,7 +137,7 @@ MassInterval MassBounds::bounds(double a, double b, double m_lo, double m_hi, do
     result = cdf_bounds(a, b, m_lo, m_hi, s_lo, s_hi, 1);
   } else if (s_lo == s_hi && peak_ != Peak::None) {
     // g is unimodal in m: its minimum at an endpoint, its maximum at the (clamped) peak.
-    result.lo = std::min(at_mean(a, b, m_lo, s_lo).lo, at_mean(a, b, m_hi, s_lo).lo);
+    result.lo = std::min(lower_at_mean(a, b, m_lo, s_lo), lower_at_mean(a, b, m_hi, s_lo));
     result.hi = peak_upper(a, b, m_lo, m_hi, s_lo);
   } else {
     result = cdf_bounds(a, b, m_lo, m_hi, s_lo, s_hi, kSplits);
@@ -161,8 +166,8 @@ double MassBounds::peak_upper(double a, double b, double m_lo, double m_hi, doub
   }
   // Each operation above errs by at most u of its operands' magnitude.
   const double margin = 4.0 * kUnitRoundoff * magnitude + std::numeric_limits<double>::denorm_min();
-  if (peak_mean + margin < m_lo) return at_mean(a, b, m_lo, s).hi;
-  if (peak_mean - margin > m_hi) return at_mean(a, b, m_hi, s).hi;
+  if (peak_mean + margin < m_lo) return upper_at_mean(a, b, m_lo, s);
+  if (peak_mean - margin > m_hi) return upper_at_mean(a, b, m_hi, s);
   return upper_mass(za, zb);
 }
 
@@ -201,8 +206,8 @@ int MassBounds::slope_sign(double a, double b, double m, double s) const {
 double MassBounds::bisection_upper(double a, double b, double m_lo, double m_hi, double s) const {
   // g is log-concave: g' > 0 at l means g is nondecreasing on [m_lo, l], g' < 0 at r nonincreasing
   // on [r, m_hi]; so the maximum over [m_lo, m_hi] is the maximum over [l, r].
-  if (slope_sign(a, b, m_lo, s) < 0) return at_mean(a, b, m_lo, s).hi;
-  if (slope_sign(a, b, m_hi, s) > 0) return at_mean(a, b, m_hi, s).hi;
+  if (slope_sign(a, b, m_lo, s) < 0) return upper_at_mean(a, b, m_lo, s);
+  if (slope_sign(a, b, m_hi, s) > 0) return upper_at_mean(a, b, m_hi, s);
   double l = m_lo, r = m_hi;
   for (int step = 0; step < kMaxBisections; ++step) {
     const double mid = l + 0.5 * (r - l);

@@ -107,7 +107,8 @@ class MassBounds {
   double standard_mass(double za, double zb) const;
   double lower_mass(double za, double zb) const;  // standard_mass widened down, rounded down
   double upper_mass(double za, double zb) const;
-  MassInterval at_mean(double a, double b, double m, double s) const;  // one mean, one scale
+  double lower_at_mean(double a, double b, double m, double s) const;  // one mean, one scale
+  double upper_at_mean(double a, double b, double m, double s) const;
   double peak_upper(double a, double b, double m_lo, double m_hi, double s) const;
   double bisection_upper(double a, double b, double m_lo, double m_hi, double s) const;
   int slope_sign(double a, double b, double m, double s) const;  // certain sign of g', else 0
