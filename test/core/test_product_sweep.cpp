@@ -1,9 +1,9 @@
 // The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
-// ties, the leave and cut outcomes); the sweep gives product_expectation()'s row by row, and its
-// estimate for the input choice is never below it, and sweeps that share buffers give what each
-// gives alone; rows that share a mean box through what the map reads get the bounds they would
-// compute themselves.
+// ties, the leave and cut outcomes), and so do several lines at once; the sweep gives
+// product_expectation()'s row by row, its estimate for the input choice is never below it, and
+// sweeps that share buffers give what each gives alone; rows that share a mean box through what
+// the map reads get the bounds they would compute themselves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,6 +104,43 @@ TEST(ProductSweep, OrderedExpectationIsTheSortedOneBitForBit) {
                                       window_sums(row.window), bound),
                   sorted_expectation(line, row, bound))
             << "length " << length << " trial " << trial;
+      }
+    }
+  }
+}
+
+TEST(ProductSweep, LinesAtOnceGiveEachLineItsOwnBitForBit) {
+  std::mt19937 random(kSeed);
+  // 41 and 64: batches of short lines; 65 and 200: one line at a time.
+  for (std::size_t length : {std::size_t(1), std::size_t(41), std::size_t(64), std::size_t(65), std::size_t(200)}) {
+    for (std::size_t line_count = 1; line_count <= 9; ++line_count) {
+      for (int trial = 0; trial < kRandomRows / 40; ++trial) {
+        RandomRow row = random_row(random, length);
+        row.window.cells = row.cells.data();
+        std::vector<double> lines;
+        for (std::size_t k = 0; k < line_count; ++k) {
+          const std::vector<double> line = random_line(random, length);
+          lines.insert(lines.end(), line.begin(), line.end());
+        }
+        for (Bound bound : {Bound::Lower, Bound::Upper}) {
+          std::vector<std::uint32_t> orders, ranks;
+          for (std::size_t k = 0; k < line_count; ++k) {
+            std::vector<std::uint32_t> order, rank;
+            order_of(std::vector<double>(lines.begin() + std::ptrdiff_t(k * length),
+                                         lines.begin() + std::ptrdiff_t((k + 1) * length)),
+                     bound, order, rank);
+            orders.insert(orders.end(), order.begin(), order.end());
+            ranks.insert(ranks.end(), rank.begin(), rank.end());
+          }
+          const WindowSums sums = window_sums(row.window);
+          std::vector<double> together(line_count);
+          ordered_expectations(lines.data(), orders.data(), ranks.data(), length, line_count, row.window, sums, bound,
+                               together.data());
+          for (std::size_t k = 0; k < line_count; ++k)
+            ASSERT_EQ(together[k], ordered_expectation(lines.data() + k * length, orders.data() + k * length,
+                                                       ranks.data() + k * length, length, row.window, sums, bound))
+                << "length " << length << " lines " << line_count << " line " << k << " trial " << trial;
+        }
       }
     }
   }

@@ -35,27 +35,17 @@ WindowSums window_sums(const DimensionView& window) {
   return sums;
 }
 
-double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                           std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound) {
+namespace {
+
+// The rest of an O-maximisation once `result` holds the expectation at the lower bounds: the
+// budget 1 - sums.lo goes to the window's cells with slack in filling order, leave and cut at their
+// places, as robust_expectation() gives it; then the outward rounding and the clamp. `mask` (lines
+// up to kMaskBits long) has the bits of those cells' ranks set; null: a scan of the whole order.
+double give_budget(double result, const double* line, const std::uint32_t* order, std::size_t length,
+                   const DimensionView& window, const WindowSums& sums, Bound bound, const std::uint64_t* mask) {
   const std::size_t count = window.count, first = std::size_t(window.first);
-  require(window.first >= 0 && first + count <= length, "a window inside its line");
   const MassInterval* cells = window.cells;
   const double cut = cut_value(bound);
-  // The expectation at the lower bounds in robust_expectation()'s order. Lines up to kMaskBits
-  // long also mark the window's cells with slack as bits at their ranks: visiting the set bits in
-  // increasing order visits exactly them, in filling order.
-  const bool masked = length <= kMaskBits;
-  std::uint64_t mask[kMaskBits / 64] = {};
-  double result = 0.0;
-  for (std::size_t j = 0; j < count; ++j) {
-    result += cells[j].lo * line[first + j];
-    if (masked) {
-      const std::uint32_t r = rank[first + j];
-      mask[r / 64] |= std::uint64_t(cells[j].hi - cells[j].lo > 0.0) << (r % 64);
-    }
-  }
-  result += window.leave.lo * 0.0;
-  result += window.cut.lo * cut;
   const double rounding = robust_expectation_rounding(count + 2);
   // Leave and cut come after the line's cells of the same value (their index is larger).
   struct Extra {
@@ -77,7 +67,7 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
     for (; next_extra < 2 && extras[next_extra].key < key && budget > 0.0; ++next_extra)
       give(extras[next_extra].value, extras[next_extra].slack);
   };
-  if (masked) {
+  if (mask) {
     for (std::size_t word = 0; word * 64 < length && budget > 0.0; ++word) {
       for (std::uint64_t bits = mask[word]; bits && budget > 0.0; bits &= bits - 1) {
         const std::size_t position = order[word * 64 + std::size_t(__builtin_ctzll(bits))];
@@ -101,6 +91,72 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
   for (; next_extra < 2 && budget > 0.0; ++next_extra) give(extras[next_extra].value, extras[next_extra].slack);
   result = bound == Bound::Lower ? result - rounding : result + rounding;
   return std::clamp(result, 0.0, 1.0);
+}
+
+// ordered_expectations() of kLines lines at once, each at most 64 long: the sums at the lower
+// bounds of several lines are independent chains of additions, which the processor overlaps.
+template <std::size_t kLines>
+void short_lines_expectations(const double* lines, const std::uint32_t* orders, const std::uint32_t* ranks,
+                              std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound,
+                              double* out) {
+  const std::size_t count = window.count, first = std::size_t(window.first);
+  const MassInterval* cells = window.cells;
+  double result[kLines] = {};
+  std::uint64_t mask[kLines] = {};
+  for (std::size_t j = 0; j < count; ++j) {
+    const double lo = cells[j].lo;
+    const std::uint64_t slack = cells[j].hi - cells[j].lo > 0.0;
+    for (std::size_t k = 0; k < kLines; ++k) {
+      result[k] += lo * lines[k * length + first + j];
+      mask[k] |= slack << ranks[k * length + first + j];
+    }
+  }
+  const double cut = cut_value(bound);
+  for (std::size_t k = 0; k < kLines; ++k) {
+    result[k] += window.leave.lo * 0.0;
+    result[k] += window.cut.lo * cut;
+    out[k] = give_budget(result[k], lines + k * length, orders + k * length, length, window, sums, bound, &mask[k]);
+  }
+}
+
+}  // namespace
+
+double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                           std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound) {
+  const std::size_t count = window.count, first = std::size_t(window.first);
+  require(window.first >= 0 && first + count <= length, "a window inside its line");
+  const MassInterval* cells = window.cells;
+  // The expectation at the lower bounds in robust_expectation()'s order. Lines up to kMaskBits
+  // long also mark the window's cells with slack as bits at their ranks: visiting the set bits in
+  // increasing order visits exactly them, in filling order.
+  const bool masked = length <= kMaskBits;
+  std::uint64_t mask[kMaskBits / 64] = {};
+  double result = 0.0;
+  for (std::size_t j = 0; j < count; ++j) {
+    result += cells[j].lo * line[first + j];
+    if (masked) {
+      const std::uint32_t r = rank[first + j];
+      mask[r / 64] |= std::uint64_t(cells[j].hi - cells[j].lo > 0.0) << (r % 64);
+    }
+  }
+  result += window.leave.lo * 0.0;
+  result += window.cut.lo * cut_value(bound);
+  return give_budget(result, line, order, length, window, sums, bound, masked ? mask : nullptr);
+}
+
+void ordered_expectations(const double* lines, const std::uint32_t* orders, const std::uint32_t* ranks,
+                          std::size_t length, std::size_t line_count, const DimensionView& window,
+                          const WindowSums& sums, Bound bound, double* out) {
+  require(window.first >= 0 && std::size_t(window.first) + window.count <= length, "a window inside its line");
+  constexpr std::size_t kBatch = 4;
+  std::size_t k = 0;
+  if (length <= 64)
+    for (; k + kBatch <= line_count; k += kBatch)
+      short_lines_expectations<kBatch>(lines + k * length, orders + k * length, ranks + k * length, length, window,
+                                       sums, bound, out + k);
+  for (; k < line_count; ++k)
+    out[k] = ordered_expectation(lines + k * length, orders + k * length, ranks + k * length, length, window, sums,
+                                 bound);
 }
 
 bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
@@ -167,12 +223,10 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
       const RowBounds::SuffixParts parts = rows_.suffix_parts(d, std::uint32_t(suffix_class));
       const DimensionView& window = rows_.distinct(d, parts.bounds);
       const WindowSums& sums = sums_[d][parts.bounds];
-      for (std::size_t p = 0; p < prefixes; ++p) {
-        const std::size_t line = (std::size_t(parts.next) * prefixes + p) * length;
-        table[suffix_class * prefixes + p] =
-            ordered_expectation(source + line, source_order.order.data() + line, source_order.rank.data() + line,
-                                length, window, sums, bound_);
-      }
+      // The source's lines of class `next` are consecutive: prefix p at (next * prefixes + p) * length.
+      const std::size_t lines = std::size_t(parts.next) * prefixes * length;
+      ordered_expectations(source + lines, source_order.order.data() + lines, source_order.rank.data() + lines,
+                           length, prefixes, window, sums, bound_, table + suffix_class * prefixes);
     }
   });
 }

@@ -95,4 +95,11 @@ class ProductSweep {
 double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
                            std::size_t length, const DimensionView& window, const WindowSums& sums, Bound bound);
 
+/// ordered_expectation() of `line_count` consecutive lines (line k at lines + k * length, its
+/// order and rank at the same offsets) with one window, into out[0..line_count): the same results,
+/// bit for bit, several short lines at a time.
+void ordered_expectations(const double* lines, const std::uint32_t* orders, const std::uint32_t* ranks,
+                          std::size_t length, std::size_t line_count, const DimensionView& window,
+                          const WindowSums& sums, Bound bound, double* out);
+
 }  // namespace amytiss::detail
