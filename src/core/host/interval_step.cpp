@@ -1,5 +1,6 @@
 #include "host/interval_step.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace amytiss::detail {
@@ -86,17 +87,32 @@ double IntervalStep::estimate(std::size_t cell, std::size_t input) const {
   return estimate;
 }
 
-std::size_t IntervalStep::most_promising(std::size_t cell) const {
-  std::size_t most_promising = 0;
-  double highest = -std::numeric_limits<double>::infinity();
+double IntervalStep::choose(std::size_t cell, const double* in, ProductScratch& scratch, std::vector<double>& estimates,
+                            std::uint32_t& chosen) const {
+  // The maximiser with the lowest index. With the sweep, every input's estimate is read first (the
+  // reads overlap), the input chosen at the previous step goes first (before any choice, the one
+  // with the highest estimate), and an input whose estimate cannot beat the best so far is
+  // skipped: it can only tie with it when its index is lower, so those need a strictly lower
+  // estimate.
+  std::size_t seed = 0;
+  if (sweep_) {
+    estimates.resize(a_.inputs.size());
+    for (std::size_t u = 0; u < a_.inputs.size(); ++u) estimates[u] = estimate(cell, u);
+    seed = last_choice_[cell];
+    if (seed == kNoChoice) seed = std::size_t(std::max_element(estimates.begin(), estimates.end()) - estimates.begin());
+  }
+  double best = worst_case(cell, seed, in, scratch);
+  chosen = std::uint32_t(seed);
   for (std::size_t u = 0; u < a_.inputs.size(); ++u) {
-    const double most = estimate(cell, u);
-    if (most > highest) {
-      highest = most;
-      most_promising = u;
+    if (u == seed) continue;
+    if (sweep_ && (estimates[u] < best || (estimates[u] == best && u > chosen))) continue;
+    const double value = worst_case(cell, u, in, scratch);
+    if (value > best || (value == best && u < chosen)) {
+      best = value;
+      chosen = std::uint32_t(u);
     }
   }
-  return most_promising;
+  return best;
 }
 
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
@@ -105,6 +121,7 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);
+    std::vector<double> estimates;
     for (std::size_t visit = first; visit < last; ++visit) {
       const std::size_t cell = visit_order_.empty() ? visit : visit_order_[visit];
       chosen[cell] = 0;
@@ -112,27 +129,8 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
         out[cell] = a_.terminal_value(roles_[cell]);
         continue;
       }
-      // The maximiser with the lowest index. With the sweep, the input chosen at the previous step
-      // goes first, and an input whose estimate cannot beat the best so far is skipped: it can
-      // only tie with it when its index is lower, so those need a strictly lower estimate.
-      // Before any choice, the input with the highest estimate goes first.
-      const std::size_t seed = !sweep_ ? 0 : last_choice_[cell] != kNoChoice ? last_choice_[cell] : most_promising(cell);
-      double best = worst_case(cell, seed, in, scratch);
-      chosen[cell] = std::uint32_t(seed);
-      for (std::size_t u = 0; u < a_.inputs.size(); ++u) {
-        if (u == seed) continue;
-        if (sweep_) {
-          const double most = estimate(cell, u);
-          if (most < best || (most == best && u > chosen[cell])) continue;
-        }
-        const double value = worst_case(cell, u, in, scratch);
-        if (value > best || (value == best && u < chosen[cell])) {
-          best = value;
-          chosen[cell] = std::uint32_t(u);
-        }
-      }
+      out[cell] = choose(cell, in, scratch, estimates, chosen[cell]);
       if (sweep_) last_choice_[cell] = chosen[cell];
-      out[cell] = best;
     }
   });
 }

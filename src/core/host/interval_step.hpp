@@ -39,8 +39,10 @@ class IntervalStep : public BellmanStep {
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
   // At least worst_case() (sweep only): min over disturbances of ProductSweep::upper_estimate().
   double estimate(std::size_t cell, std::size_t input) const;
-  // The input with the highest estimate (sweep only), the lowest index among equals.
-  std::size_t most_promising(std::size_t cell) const;
+  // The cell's best worst case over the inputs, and the input that gives it into `chosen`;
+  // `estimates`: scratch.
+  double choose(std::size_t cell, const double* in, ProductScratch& scratch, std::vector<double>& estimates,
+                std::uint32_t& chosen) const;
   void reset_stage_caches();
   void use_stage_caches(ProductScratch& scratch) const;
   const Abstraction& a_;
