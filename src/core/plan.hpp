@@ -13,7 +13,7 @@
 #include "amytiss/synthesis_types.hpp"
 #include "host/robust_reference.hpp"
 #include "opencl/device.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 #include "scale_out/team.hpp"
 
 namespace amytiss::detail {

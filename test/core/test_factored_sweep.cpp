@@ -10,7 +10,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/device.hpp"

@@ -35,6 +35,12 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
     visit_order_ = first_dimension_fastest(a_.states);
     return;
   }
+  if (std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a_, nullptr)) {
+    std::vector<bool> has_rows(roles_.size());
+    for (std::size_t cell = 0; cell < roles_.size(); ++cell) has_rows[cell] = roles_[cell] == CellRole::Free;
+    factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, std::move(*plan), bound_, threads_);
+    return;
+  }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
   // when it has fewer entries than the lines the rows would compute (kLinesPerRow per row and
   // stage at least) and fits the budget; clearing it at every step is then cheap.
@@ -48,6 +54,15 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
     stage_cache_entries_[d] = entries;
     budget -= entries;
   }
+}
+
+std::string IntervalStep::method() const {
+  if (set_ == AmbiguitySet::Joint) return "the joint interval MDP row by row";
+  if (sweep_) return "the product set over whole tables";
+  if (!factored_) return "the product set row by row";
+  std::string order;
+  for (std::size_t d : factored_->order()) order += " x'" + std::to_string(d);
+  return "the product set by variable elimination (eliminates" + order + ")";
 }
 
 void IntervalStep::reset_stage_caches() {
@@ -115,7 +130,46 @@ double IntervalStep::choose(std::size_t cell, const double* in, ProductScratch& 
   return best;
 }
 
+void IntervalStep::apply_factored(double* out, std::uint32_t* chosen, const std::uint32_t* controller) const {
+  parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
+    for (std::size_t cell = first; cell < last; ++cell) {
+      if (chosen) chosen[cell] = 0;
+      if (roles_[cell] != CellRole::Free) {
+        out[cell] = a_.terminal_value(roles_[cell]);
+        continue;
+      }
+      auto worst = [&](std::size_t input) {
+        double value = std::numeric_limits<double>::infinity();
+        for (std::size_t w = 0; w < a_.disturbances.size(); ++w)
+          value = std::min(value, factored_->expectation(cell, input, w));
+        return value;
+      };
+      if (controller) {
+        out[cell] = worst(controller[cell]);
+        continue;
+      }
+      // The maximiser with the lowest index.
+      double best = worst(0);
+      std::uint32_t best_input = 0;
+      for (std::size_t u = 1; u < a_.inputs.size(); ++u) {
+        const double value = worst(u);
+        if (value > best) {
+          best = value;
+          best_input = std::uint32_t(u);
+        }
+      }
+      out[cell] = best;
+      chosen[cell] = best_input;
+    }
+  });
+}
+
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
+  if (factored_) {
+    factored_->prepare(in);
+    apply_factored(out, chosen, nullptr);
+    return;
+  }
   reset_stage_caches();
   if (sweep_) sweep_->prepare(in);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
@@ -136,6 +190,11 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
 }
 
 void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* controller) {
+  if (factored_) {
+    factored_->prepare(in);
+    apply_factored(out, nullptr, controller);
+    return;
+  }
   reset_stage_caches();
   if (sweep_) sweep_->prepare(in);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {

@@ -6,12 +6,14 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
 #include "host/bellman_step.hpp"
 #include "host/interval_bellman.hpp"
 #include "host/product_sweep.hpp"
+#include "host/robust_factored.hpp"
 #include "host/robust_reference.hpp"
 #include "host/row_bounds.hpp"
 
@@ -33,10 +35,16 @@ class IntervalStep : public BellmanStep {
   /// The O-maximisation's outward rounding keeps the sequences apart by at most this.
   double resolution() const override { return 1e-12; }
   const std::vector<CellRole>& roles() const { return roles_; }
+  /// How the step computes the rows' bounds, for the notes: the product set over whole tables, by
+  /// variable elimination (with its order) or row by row, or the joint interval MDP.
+  std::string method() const;
 
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
+  // The step from the factored sweep's Q (after its prepare()): every input of every Free cell,
+  // or the controller's input where `controller` is not null.
+  void apply_factored(double* out, std::uint32_t* chosen, const std::uint32_t* controller) const;
   // At least worst_case() (sweep only): min over disturbances of ProductSweep::upper_estimate().
   double estimate(std::size_t cell, std::size_t input) const;
   // The cell's best worst case over the inputs, and the input that gives it into `chosen`;
@@ -57,6 +65,9 @@ class IntervalStep : public BellmanStep {
   std::vector<std::size_t> stage_cache_entries_;
   // The product set over whole tables where it pays (host/product_sweep.hpp); then no caches.
   std::unique_ptr<ProductSweep> sweep_;
+  // Else the product set by variable elimination where the factored sweep has a plan
+  // (host/robust_factored.hpp); then no caches either.
+  std::unique_ptr<RobustFactoredSweep> factored_;
   static constexpr std::uint32_t kNoChoice = ~std::uint32_t(0);
   std::vector<std::uint32_t> last_choice_;  // per cell, the input apply() chose last (sweep only)
   std::vector<std::uint32_t> visit_order_;  // the order apply() visits the cells in (sweep only)

@@ -192,11 +192,12 @@ ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound boun
   }
 }
 
-void ProductSweep::sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const {
+void sort_lines(const double* lines, std::size_t count, std::size_t length, Bound bound, unsigned threads,
+                LineOrder& sorted) {
   sorted.order.resize(count * length);
   sorted.rank.resize(count * length);
-  const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
-  parallel_for(count, threads_, [&](unsigned, std::size_t first, std::size_t last) {
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  parallel_for(count, threads, [&](unsigned, std::size_t first, std::size_t last) {
     for (std::size_t line = first; line < last; ++line) {
       const double* values = lines + line * length;
       std::uint32_t* positions = sorted.order.data() + line * length;
@@ -214,7 +215,7 @@ void ProductSweep::run_stage(std::size_t d, const double* source) {
   const std::size_t source_classes = d + 1 == states_.dims() ? 1 : rows_.suffix_classes(d + 1);
   // Line (next, p) of the source: the values at prefix p * length + k of class next.
   LineOrder& source_order = buffers_->source_order;
-  sort_lines(source, source_classes * prefixes, length, source_order);
+  sort_lines(source, source_classes * prefixes, length, bound_, threads_, source_order);
   std::vector<double>& stage = buffers_->tables[d];
   stage.resize(prefixes * rows_.suffix_classes(d));
   double* table = stage.data();
@@ -238,7 +239,7 @@ void ProductSweep::prepare(const double* values) {
   for (std::size_t d = dims; d-- > 1;) run_stage(d, d + 1 == dims ? values : tables[d + 1].data());
   stage0_lines_ = dims == 1 ? values : tables[1].data();
   const std::size_t lines = dims == 1 ? 1 : rows_.suffix_classes(1), length = states_.count(0);
-  sort_lines(stage0_lines_, lines, length, buffers_->stage0_order);
+  sort_lines(stage0_lines_, lines, length, bound_, threads_, buffers_->stage0_order);
   std::vector<double>& rising = buffers_->rising_max;
   std::vector<double>& falling = buffers_->falling_max;
   rising.resize(lines * length);

@@ -30,6 +30,12 @@ struct LineOrder {
   std::vector<std::uint32_t> order, rank;
 };
 
+/// Sorts each of `count` lines of `length` values (line k at lines + k * length) into `sorted`:
+/// the positions in `bound`'s filling order (increasing values for the lower bound, decreasing
+/// for the upper; stable), on `threads` workers.
+void sort_lines(const double* lines, std::size_t count, std::size_t length, Bound bound, unsigned threads,
+                LineOrder& sorted);
+
 /// What one ProductSweep::prepare() builds and its expectations read: the stage tables, the lines'
 /// sort orders and stage 0's running maxima. Every prepare() rebuilds all of it, so sweeps that
 /// never run at the same time (a step's lower and upper bound) can share one and touch half the
@@ -69,7 +75,6 @@ class ProductSweep {
  private:
   // Stage d's table, [suffix class][prefix], from its source's lines.
   void run_stage(std::size_t d, const double* source);
-  void sort_lines(const double* lines, std::size_t count, std::size_t length, LineOrder& sorted) const;
   const Grid& states_;
   const RowBounds& rows_;
   Bound bound_;

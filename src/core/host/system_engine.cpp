@@ -37,17 +37,16 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
                  double(a.pairs()) / std::max(construction_seconds, 1e-9));
   reporter.report().transitions = "interval bounds per dimension: " + format_bytes(double(rows.bytes())) +
                                   " on the host (" + std::to_string(rows.intervals()) + " mass intervals)";
-  reporter.report().notes.push_back(
-      {NoteSeverity::Info, NoteKind::Transitions,
-       "continuous-system bounds: image enclosures of every cell, " + std::to_string(rows.intervals()) +
-           " per-dimension mass intervals (" + format_bytes(double(rows.bytes())) + "), " +
-           (set == AmbiguitySet::Joint ? "joint interval MDP" : "product interval MDP") + " on " +
-           std::to_string(threads) + " host thread" + (threads == 1 ? "" : "s")});
   reporter.reached(Phase::Construction);
   // The backward driver runs the two bounds' steps one after the other: one set of sweep buffers.
   const auto sweep_buffers = std::make_shared<SweepBuffers>();
   IntervalStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads, sweep_buffers);
   IntervalStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads, sweep_buffers);
+  reporter.report().notes.push_back(
+      {NoteSeverity::Info, NoteKind::Transitions,
+       "continuous-system bounds: image enclosures of every cell, " + std::to_string(rows.intervals()) +
+           " per-dimension mass intervals (" + format_bytes(double(rows.bytes())) + "), " + lower.method() +
+           " on " + std::to_string(threads) + " host thread" + (threads == 1 ? "" : "s")});
   return run_backward_bounds(a, lower, upper, reporter);
 }
 

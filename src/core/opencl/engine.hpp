@@ -10,7 +10,7 @@
 #include "host/backward_driver.hpp"
 #include "opencl/device.hpp"
 #include "opencl/engine_options.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 
 namespace amytiss::detail {
 

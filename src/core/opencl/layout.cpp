@@ -21,9 +21,8 @@ Layout::Layout(const Abstraction& a) {
     whole[i] = a.noise->whole_grid_dims()[i] ? 1 : 0;
     // A whole-grid window is the dimension itself: no padding, n cells from index 0 (padding
     // by n - 1 on each side would make the value array (3n - 2)^d: 2^28 cells for StocHy 14-d).
-    // Otherwise the window never needs more than the grid: h <= n - 1 bounds the padding.
-    half[i] = whole[i] ? 0 : std::min<long long>(h[i], count - 1);
-    width[i] = whole[i] ? count : 2 * half[i] + 1;
+    width[i] = static_cast<long long>(dense_window_width(a, i));
+    half[i] = whole[i] ? 0 : (width[i] - 1) / 2;
     mass_offset[i] = mass_record;
     mass_record += width[i];
     padded_count[i] = count + 2 * half[i];
@@ -46,16 +45,6 @@ std::size_t Layout::padded_offset(const Grid& states, std::size_t flat) const {
 
 std::size_t Layout::record_bytes() const {
   return sizeof(std::uint32_t) + sizeof(float) * static_cast<std::size_t>(mass_record);
-}
-
-double contraction_multiply_adds(const Abstraction& abstraction) {
-  const Layout layout(abstraction);
-  double total = 0, product = 1;
-  for (long long width : layout.width) {
-    product *= double(width);
-    total += product;
-  }
-  return total;
 }
 
 }  // namespace detail

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
+#include "host/factored_plan.hpp"  // dense_window_width(), contraction_multiply_adds()
 
 namespace amytiss::detail {
 
@@ -31,8 +32,5 @@ struct Layout {
   /// Bytes of one stored transition record: a uint32 padded offset + mass_record float32 masses.
   std::size_t record_bytes() const;
 };
-
-/// Nominal multiply-adds of one separable contraction of the problem's window.
-double contraction_multiply_adds(const Abstraction& abstraction);
 
 }  // namespace amytiss::detail

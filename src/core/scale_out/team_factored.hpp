@@ -8,7 +8,7 @@
 #include "amytiss/policy.hpp"
 #include "host/backward_driver.hpp"
 #include "opencl/engine_options.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 #include "scale_out/team.hpp"
 
 namespace amytiss::detail {

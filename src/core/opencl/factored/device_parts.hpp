@@ -8,7 +8,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {

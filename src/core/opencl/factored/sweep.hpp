@@ -7,7 +7,7 @@
 #include "amytiss/policy.hpp"
 #include "host/backward_driver.hpp"
 #include "opencl/device.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 
 namespace amytiss::detail {
 

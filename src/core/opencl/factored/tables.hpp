@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 
 namespace amytiss::detail {
 

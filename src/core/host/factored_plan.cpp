@@ -1,4 +1,4 @@
-#include "opencl/factored/plan.hpp"
+#include "host/factored_plan.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +7,6 @@
 #include <numeric>
 
 #include "amytiss/format.hpp"
-#include "opencl/layout.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -250,6 +249,21 @@ std::string variable_name(const FactorVariable& variable) {
 }
 
 }  // namespace
+
+std::size_t dense_window_width(const Abstraction& a, std::size_t dim) {
+  const auto count = std::int64_t(a.states.count(dim));
+  if (a.noise->whole_grid_dims()[dim]) return std::size_t(count);
+  return std::size_t(2 * std::min<std::int64_t>(a.noise->window_half_cells()[dim], count - 1) + 1);
+}
+
+double contraction_multiply_adds(const Abstraction& a) {
+  double total = 0, product = 1;
+  for (std::size_t dim = 0; dim < a.states.dims(); ++dim) {
+    product *= double(dense_window_width(a, dim));
+    total += product;
+  }
+  return total;
+}
 
 std::string FactoredPlan::describe() const {
   std::string text = "factored sweep: eliminates";

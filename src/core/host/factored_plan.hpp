@@ -73,6 +73,13 @@ struct FactoredPlan {
   std::string describe() const;
 };
 
+/// Cells of dimension `dim` that the dense sweep's window spans: the whole dimension without
+/// truncation, else 2 h + 1 for the noise's half-width h, h at most count - 1 (the window never
+/// needs more than the grid on either side).
+std::size_t dense_window_width(const Abstraction& abstraction, std::size_t dim);
+/// Nominal multiply-adds of one separable contraction of the problem's window.
+double contraction_multiply_adds(const Abstraction& abstraction);
+
 /// The cheapest elimination order whose buffers fit `budget_bytes` in all and `max_buffer_bytes`
 /// each, or nullopt with the reason (dynamics without dependency information, non-separable
 /// noise, nothing fits).
