@@ -26,7 +26,7 @@ foreach(node synthesizer policy_server plant_simulator)
 endforeach()
 
 # Load test client of the service (scripts/bench_service runs it).
-add_executable(bench_service src/tools/bench_service.cpp)
+add_executable(bench_service src/tools/bench_service.cpp src/tools/tcpros_service_client.cpp)
 target_link_libraries(bench_service amytiss_ros)
 
 install(TARGETS amytiss_ros synthesizer policy_server plant_simulator bench_service
@@ -67,6 +67,11 @@ if(CATKIN_ENABLE_TESTING)
         AMYTISS_POLICY_SERVER_BIN="$<TARGET_FILE:policy_server>")
     endif()
   endforeach()
+  # The service test checks the load test's TCPROS client too.
+  if(TARGET amytiss_rostest_service)
+    target_sources(amytiss_rostest_service PRIVATE src/tools/tcpros_service_client.cpp)
+    target_include_directories(amytiss_rostest_service PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/tools)
+  endif()
   # The service test again, on a policy of continuous-system bounds (guarantee: system).
   if(TARGET amytiss_rostest_service)
     add_rostest(test/ros/service_system.test DEPENDENCIES amytiss_rostest_service)

@@ -20,6 +20,7 @@
 #include "amytiss/policy_file.hpp"
 #include "rostest_nodes.hpp"
 #include "rostest_support.hpp"
+#include "tcpros_service_client.hpp"
 
 // A request written byte by byte, to send what no well-formed client would.
 struct RawRequest {
@@ -167,6 +168,47 @@ TEST_F(ServiceTest, ARequestClaimingMoreStateValuesThanItCarriesIsAnsweredWithou
   EXPECT_NE(response.message.find("claims 536870912 values"), std::string::npos) << response.message;
   EXPECT_LT(peak_memory_kib(server) - peak_before, kOversizedGrowthLimitKiB);
   EXPECT_TRUE(call({-4.0, -4.0}, 0).success) << "the server stays up";
+}
+
+TEST_F(ServiceTest, TheLoadTestsTcprosClientGetsWhatRoscppsClientGets) {
+  amytiss_tools::TcprosServiceClient tcpros("/amytiss/get_input",
+                                            amytiss_tools::service_md5sum<amytiss::GetInput>());
+  const amytiss::Policy& policy = loaded_.policy;
+  std::mt19937 random(kRandomSeed);
+  for (int sample = 0; sample < kSampledStates; ++sample) {
+    amytiss::GetInput service;
+    service.request.state.resize(policy.states.dims());
+    for (std::size_t d = 0; d < policy.states.dims(); ++d)
+      service.request.state[d] = std::uniform_real_distribution<double>(
+          policy.states.lb()[d] - 0.49 * policy.states.eta()[d],
+          policy.states.last_point()[d] + 0.49 * policy.states.eta()[d])(random);
+    service.request.time_step = std::uniform_int_distribution<unsigned>(0, policy.horizon - 1)(random);
+    ASSERT_TRUE(tcpros.call(service)) << tcpros.error();
+    const amytiss::GetInput::Response expected = call(service.request.state, service.request.time_step);
+    ASSERT_TRUE(service.response.success) << service.response.message;
+    EXPECT_EQ(service.response.input, expected.input);
+    EXPECT_EQ(service.response.probability, expected.probability);
+    EXPECT_EQ(service.response.probability_upper, expected.probability_upper);
+  }
+  // A malformed request is answered (success false, with the reason) on the same connection.
+  amytiss::GetInput malformed;
+  malformed.request.state = {1.0};
+  ASSERT_TRUE(tcpros.call(malformed)) << tcpros.error();
+  EXPECT_FALSE(malformed.response.success);
+  EXPECT_NE(malformed.response.message.find("expected 2"), std::string::npos) << malformed.response.message;
+  // What cannot connect says why.
+  try {
+    amytiss_tools::TcprosServiceClient("/amytiss/no_such_service", amytiss_tools::service_md5sum<amytiss::GetInput>());
+    ADD_FAILURE() << "connected to a service that does not exist";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("knows no service"), std::string::npos) << error.what();
+  }
+  try {
+    amytiss_tools::TcprosServiceClient("/amytiss/get_input", "0123456789abcdef0123456789abcdef");
+    ADD_FAILURE() << "the server accepted a client of another service type";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("refused"), std::string::npos) << error.what();
+  }
 }
 
 TEST_F(ServiceTest, StatesOnTheTopicAreAnsweredOnTheCommandTopic) {
