@@ -142,7 +142,9 @@ TEST(IntervalBellman, OrthogonalLowerBoundIsAtLeastTheJointOne) {
       const double product_lower = product_expectation(grid, row, values.data(), Bound::Lower);
       const double product_upper = product_expectation(grid, row, values.data(), Bound::Upper);
       EXPECT_GE(product_lower, joint_expectation(joint, values.data(), Bound::Lower) - kOrthogonalSlack);
-      if (!with_cut) EXPECT_LE(product_upper, joint_expectation(joint, values.data(), Bound::Upper) + kOrthogonalSlack);
+      if (!with_cut) {
+        EXPECT_LE(product_upper, joint_expectation(joint, values.data(), Bound::Upper) + kOrthogonalSlack);
+      }
       EXPECT_LE(product_lower, product_upper);
     }
   }

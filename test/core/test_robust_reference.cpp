@@ -121,12 +121,12 @@ void expect_brackets_continuous_value(const SpecConfig& spec, const LinearSystem
 }
 
 TEST(RobustReference, SafetyBracketsTheContinuousValue) {
-  expect_brackets_continuous_value(safety_spec(6), LinearSystem{0.8, 0.1, 0.15});
+  expect_brackets_continuous_value(safety_spec(6), LinearSystem{0.8, 0.1, 0.15, {}});
 }
 
 TEST(RobustReference, ReachAvoidBracketsTheContinuousValue) {
   expect_brackets_continuous_value(reach_avoid_spec(6, box({0.4}, {0.8}), box({-0.5}, {-0.3})),
-                                   LinearSystem{0.9, 0.12, 0.1});
+                                   LinearSystem{0.9, 0.12, 0.1, {}});
 }
 
 TEST(RobustReference, ControllerOfTheLowerBoundBracketsItsContinuousValue) {
@@ -149,12 +149,12 @@ TEST(RobustReference, ControllerMaximisesTheLowerBound) {
 TEST(RobustReference, TruncatedWindowsStillBracketTheContinuousValue) {
   // Windows of 5 cells (plus the box's spread) against a standard deviation of 1.5 cells.
   expect_brackets_continuous_value(reach_avoid_spec(4, box({0.4}, {0.8}), box({-0.5}, {-0.3})),
-                                   LinearSystem{0.9, 0.12, 0.15}, {0.25});
+                                   LinearSystem{0.9, 0.12, 0.15, {}}, {0.25});
 }
 
 TEST(RobustReference, OneDimensionOrthogonalEqualsJoint) {
   const Grid grid(grid_spec({-0.95}, {0.95}, {0.1}));
-  const LinearSystem system{0.9, 0.05, 0.2};
+  const LinearSystem system{0.9, 0.05, 0.2, {}};
   const NoiseModel noise(normal_noise({0.04}, Truncation::FixedRegion, 1e-3, {0.35}), grid);
   const SpecConfig spec = reach_avoid_spec(4, box({0.4}, {0.8}));
   const RobustValues joint = robust_1d(grid, system, spec, AmbiguitySet::Joint, noise);
@@ -193,8 +193,9 @@ void compare_orthogonal_with_joint(const Grid& states, const Grid& inputs, const
     EXPECT_GE(product.lower[c], joint.lower[c] - kOrthogonalSlack) << "cell " << c;
     // With truncation the product set may value differently the mass one dimension cuts and
     // another sends off the grid: only the lower bounds compare then.
-    if (noise_config.truncation == Truncation::None)
+    if (noise_config.truncation == Truncation::None) {
       EXPECT_LE(product.upper[c], joint.upper[c] + kOrthogonalSlack) << "cell " << c;
+    }
     EXPECT_LE(product.lower[c], product.upper[c]) << "cell " << c;
     tighter_somewhere = tighter_somewhere || product.lower[c] > joint.lower[c] + kOrthogonalSlack;
   }

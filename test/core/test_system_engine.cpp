@@ -46,12 +46,15 @@ std::string small_3d_yaml(unsigned horizon, bool truncated = true) {
 
 RobustValues oracle(const Abstraction& a, AmbiguitySet set) {
   const ImageEnclosure enclosure(a.config);
-  RobustProblem problem{a.states, a.inputs, a.disturbances, *a.noise,
-                        enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances)};
-  problem.spec = a.spec;
-  problem.horizon = a.horizon;
-  problem.lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
-  problem.upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
+  const RobustProblem problem{a.states,
+                              a.inputs,
+                              a.disturbances,
+                              *a.noise,
+                              enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances),
+                              a.spec,
+                              a.horizon,
+                              robust_cell_roles(a.states, a.config.spec, Bound::Lower),
+                              robust_cell_roles(a.states, a.config.spec, Bound::Upper)};
   return robust_values(problem, set);
 }
 
