@@ -149,5 +149,24 @@ TEST(RobustFactored, StepTakesVariableEliminationAndStaysWithinTheJointBounds) {
   }
 }
 
+TEST(RobustFactored, UnboundedBoundsByVariableEliminationAreSoundAroundTheBoundedOnes) {
+  // Interval iteration and the certification of its controller run the same step: reaching
+  // within 3 steps is no more likely than ever reaching.
+  std::string unbounded = narrow_2d_yaml();
+  unbounded.replace(unbounded.find("horizon: 3"), 10, "horizon: infinite, tolerance: 1.0e-4");
+  const Policy stationary = synthesize(from_yaml(unbounded), SynthesisOptions{}, nullptr);
+  const Policy bounded = synthesize(from_yaml(narrow_2d_yaml()), SynthesisOptions{}, nullptr);
+  ASSERT_TRUE(stationary.stationary);
+  EXPECT_GT(stationary.iterations, 0u);
+  bool reaches = false;
+  for (std::size_t x = 0; x < stationary.states.size(); ++x) {
+    EXPECT_LE(stationary.value(0, x), stationary.upper_value(0, x) + kOrderSlack) << "cell " << x;
+    EXPECT_LE(bounded.value(0, x), stationary.upper_value(0, x) + kOrderSlack) << "cell " << x;
+    reaches = reaches || (stationary.roles[x] == CellRole::Free && stationary.value(0, x) > 0.5);
+  }
+  EXPECT_TRUE(reaches) << "no free cell with a certified chance above one half: the test checks nothing";
+  EXPECT_EQ(stationary.converged, stationary.gap <= 1.0e-4);
+}
+
 }  // namespace
 }  // namespace amytiss::detail
