@@ -187,8 +187,8 @@ ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound boun
   for (std::size_t d = 1; d < dims; ++d) prefixes_[d] = prefixes_[d - 1] * states.count(d - 1);
   for (std::uint32_t b = 0; b < rows.distinct_bounds(0); ++b) {
     const DimensionView& window = rows.distinct(0, b);
-    estimate_windows_.push_back({std::int32_t(window.first), std::int32_t(window.first + std::int64_t(window.count)) - 1,
-                                 window.cut.hi});
+    const auto first = std::int32_t(window.first), last = std::int32_t(window.first + std::int64_t(window.count)) - 1;
+    estimate_windows_.push_back({first, last, window.cut.hi});
   }
 }
 

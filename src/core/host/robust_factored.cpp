@@ -52,7 +52,8 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
   number_q(a);
 }
 
-void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows, const std::vector<bool>& has_rows) {
+void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
+                                         const std::vector<bool>& has_rows) {
   const std::size_t dims = a.states.dims();
   // A tuple no row has feeds no row's bound: any feasible window will do.
   const DimensionView nowhere{0, 0, nullptr, {0.0, 1.0}, {0.0, 0.0}};

@@ -70,7 +70,7 @@ std::vector<double> factored_terminal_values(const Abstraction& a) {
 }
 
 FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPlan& plan,
-                                          const std::vector<MassTable>& tables, cl_context context) {
+                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device) {
   const std::size_t n_states = a.states.size();
   FactoredBuffers buffers;
   cl_int error = CL_SUCCESS;
@@ -93,10 +93,17 @@ FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPl
   for (Buffer& values : buffers.values)
     values = make_buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, terminal.size() * sizeof(double), terminal.data());
   buffers.best_input = make_buffer(CL_MEM_READ_WRITE, n_states * sizeof(cl_uint), nullptr);
-  buffers.q = make_buffer(CL_MEM_READ_WRITE, plan.q_size * sizeof(double), nullptr);
+  // The large ones: on a CPU device, in host blocks that the device uses as they are.
+  auto make_large = [&](std::size_t bytes) {
+    if (!cpu_device) return make_buffer(CL_MEM_READ_WRITE, bytes, nullptr);
+    buffers.host_blocks.emplace_back(bytes);
+    return make_buffer(CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, bytes, buffers.host_blocks.back().data());
+  };
+  buffers.host_blocks.reserve(3);
+  buffers.q = make_large(plan.q_size * sizeof(double));
   if (plan.stages.size() > 1)
     for (Buffer& tensor : buffers.stage_tensors)
-      tensor = make_buffer(CL_MEM_READ_WRITE, (plan.largest_stage_tensor + kTensorSlack) * sizeof(double), nullptr);
+      tensor = make_large((plan.largest_stage_tensor + kTensorSlack) * sizeof(double));
   return buffers;
 }
 

@@ -9,6 +9,7 @@
 #include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
 #include "host/factored_plan.hpp"
+#include "opencl/host_memory.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {
@@ -51,12 +52,14 @@ FactoredKernels build_factored_kernels(const Abstraction& abstraction, const Fac
 /// A device's buffers of the factored sweep: mass tables, roles, V (both arrays start at V_{T_d}),
 /// best inputs, Q and the two stage tensors.
 struct FactoredBuffers {
+  std::vector<HostBlock> host_blocks;  // released after the buffers over them (declared first)
   std::vector<DeviceTable> tables;
   Buffer roles, values[2], best_input, q, stage_tensors[2];
   std::size_t device_bytes = 0;
 };
+/// `cpu_device`: Q and the stage tensors live in HostBlocks (opencl/host_memory.hpp).
 FactoredBuffers allocate_factored_buffers(const Abstraction& abstraction, const FactoredPlan& plan,
-                                          const std::vector<MassTable>& tables, cl_context context);
+                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device);
 /// V_{T_d} per state, then kTensorSlack zero cells.
 std::vector<double> factored_terminal_values(const Abstraction& abstraction);
 
