@@ -35,7 +35,7 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
     visit_order_ = first_dimension_fastest(a_.states);
     return;
   }
-  if (std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a_, nullptr)) {
+  if (std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a_, &no_elimination_)) {
     std::vector<bool> has_rows(roles_.size());
     for (std::size_t cell = 0; cell < roles_.size(); ++cell) has_rows[cell] = roles_[cell] == CellRole::Free;
     factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, std::move(*plan), bound_, threads_);
@@ -59,7 +59,7 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
 std::string IntervalStep::method() const {
   if (set_ == AmbiguitySet::Joint) return "the joint interval MDP row by row";
   if (sweep_) return "the product set over whole tables";
-  if (!factored_) return "the product set row by row";
+  if (!factored_) return "the product set row by row (no variable elimination: " + no_elimination_ + ")";
   std::string order;
   for (std::size_t d : factored_->order()) order += " x'" + std::to_string(d);
   return "the product set by variable elimination (eliminates" + order + ")";

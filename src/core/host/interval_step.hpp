@@ -68,6 +68,7 @@ class IntervalStep : public BellmanStep {
   // Else the product set by variable elimination where the factored sweep has a plan
   // (host/robust_factored.hpp); then no caches either.
   std::unique_ptr<RobustFactoredSweep> factored_;
+  std::string no_elimination_;  // why RobustFactoredSweep::plan() refused, where it did
   static constexpr std::uint32_t kNoChoice = ~std::uint32_t(0);
   std::vector<std::uint32_t> last_choice_;  // per cell, the input apply() chose last (sweep only)
   std::vector<std::uint32_t> visit_order_;  // the order apply() visits the cells in (sweep only)
