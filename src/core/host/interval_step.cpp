@@ -164,14 +164,15 @@ void IntervalStep::apply_factored(double* out, std::uint32_t* chosen, const std:
   });
 }
 
-void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
-  if (factored_) {
-    factored_->prepare(in);
-    apply_factored(out, chosen, nullptr);
-    return;
-  }
+void IntervalStep::prepare(const double* in) {
+  if (factored_) return factored_->prepare(in);
   reset_stage_caches();
   if (sweep_) sweep_->prepare(in);
+}
+
+void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
+  prepare(in);
+  if (factored_) return apply_factored(out, chosen, nullptr);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);
@@ -190,13 +191,8 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
 }
 
 void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* controller) {
-  if (factored_) {
-    factored_->prepare(in);
-    apply_factored(out, nullptr, controller);
-    return;
-  }
-  reset_stage_caches();
-  if (sweep_) sweep_->prepare(in);
+  prepare(in);
+  if (factored_) return apply_factored(out, nullptr, controller);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);

@@ -51,6 +51,9 @@ class IntervalStep : public BellmanStep {
   // `estimates`: scratch.
   double choose(std::size_t cell, const double* in, ProductScratch& scratch, std::vector<double>& estimates,
                 std::uint32_t& chosen) const;
+  // What a step over `in` needs before its rows: the factored sweep's Q, or the sweep's tables
+  // and emptied stage caches.
+  void prepare(const double* in);
   void reset_stage_caches();
   void use_stage_caches(ProductScratch& scratch) const;
   const Abstraction& a_;
