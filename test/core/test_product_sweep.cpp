@@ -1,6 +1,7 @@
 // The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
-// ties, the leave and cut outcomes), and so do several lines at once; the sweep gives
+// ties, the leave and cut outcomes), and so do several lines at once and several windows on one
+// line (whose sort is the test's own); the sweep gives
 // product_expectation()'s row by row, its estimate for the input choice is never below it, and
 // sweeps that share buffers give what each gives alone; rows that share a mean box through what
 // the map reads get the bounds they would compute themselves.
@@ -140,6 +141,43 @@ TEST(ProductSweep, LinesAtOnceGiveEachLineItsOwnBitForBit) {
             ASSERT_EQ(together[k], ordered_expectation(lines.data() + k * length, orders.data() + k * length,
                                                        ranks.data() + k * length, length, row.window, sums, bound))
                 << "length " << length << " lines " << line_count << " line " << k << " trial " << trial;
+        }
+      }
+    }
+  }
+}
+
+TEST(ProductSweep, WindowsAtOnceOnOneLineGiveEachWindowItsOwnBitForBit) {
+  std::mt19937 random(kSeed);
+  // 41 and 128: batches of windows (masks of one and two words); 129 and 200: one at a time.
+  for (std::size_t length : {std::size_t(1), std::size_t(41), std::size_t(128), std::size_t(129), std::size_t(200)}) {
+    for (std::size_t window_count = 1; window_count <= 9; ++window_count) {
+      for (int trial = 0; trial < kRandomRows / 40; ++trial) {
+        const std::vector<double> line = random_line(random, length);
+        std::vector<RandomRow> rows;
+        for (std::size_t k = 0; k < window_count; ++k) rows.push_back(random_row(random, length));
+        std::vector<const DimensionView*> windows;
+        std::vector<WindowSums> sums;
+        for (RandomRow& row : rows) {
+          row.window.cells = row.cells.data();
+          windows.push_back(&row.window);
+          sums.push_back(window_sums(row.window));
+        }
+        std::vector<const WindowSums*> sum_pointers;
+        for (const WindowSums& sum : sums) sum_pointers.push_back(&sum);
+        for (Bound bound : {Bound::Lower, Bound::Upper}) {
+          std::vector<std::uint32_t> order, rank, sorted_order(length), sorted_rank(length);
+          order_of(line, bound, order, rank);
+          sort_line(line.data(), length, bound, sorted_order.data(), sorted_rank.data());
+          ASSERT_EQ(sorted_order, order);
+          ASSERT_EQ(sorted_rank, rank);
+          std::vector<double> together(window_count);
+          ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, windows.data(),
+                                       sum_pointers.data(), window_count, bound, together.data());
+          for (std::size_t k = 0; k < window_count; ++k)
+            ASSERT_EQ(together[k], ordered_expectation(line.data(), order.data(), rank.data(), length, *windows[k],
+                                                       sums[k], bound))
+                << "length " << length << " windows " << window_count << " window " << k << " trial " << trial;
         }
       }
     }

@@ -100,8 +100,10 @@ TEST(RobustFactored, SweepGivesEveryRowItsBoundInThePlansOrder) {
   const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, &reason);
   ASSERT_TRUE(plan) << reason;
   std::vector<DimensionView> views(a.states.dims());
+  // The upper bound's sweep reuses the tensors the lower bound's left behind.
+  const auto buffers = std::make_shared<SweepBuffers>();
   for (Bound bound : {Bound::Lower, Bound::Upper}) {
-    RobustFactoredSweep sweep(a, rows, std::vector<bool>(a.states.size(), true), *plan, bound, 2);
+    RobustFactoredSweep sweep(a, rows, std::vector<bool>(a.states.size(), true), *plan, bound, 2, buffers);
     for (const std::vector<double>& values : test_values(a.states.size())) {
       sweep.prepare(values.data());
       for (std::size_t cell = 0; cell < a.states.size(); ++cell)

@@ -38,7 +38,8 @@ IntervalStep::IntervalStep(const Abstraction& abstraction, const RowBounds& rows
   if (std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a_, &no_elimination_)) {
     std::vector<bool> has_rows(roles_.size());
     for (std::size_t cell = 0; cell < roles_.size(); ++cell) has_rows[cell] = roles_[cell] == CellRole::Free;
-    factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, std::move(*plan), bound_, threads_);
+    factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, std::move(*plan), bound_, threads_,
+                                                      std::move(sweep_buffers));
     return;
   }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays

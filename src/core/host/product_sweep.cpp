@@ -119,6 +119,37 @@ void short_lines_expectations(const double* lines, const std::uint32_t* orders, 
   }
 }
 
+// ordered_expectation() of kWindows windows of one line at most 128 long: the sums at the lower
+// bounds are independent chains of additions, which the processor overlaps, and each window's
+// mask of ranks stays in two registers.
+template <std::size_t kWindows>
+void line_windows_expectations(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                               std::size_t length, const DimensionView* const* windows, const WindowSums* const* sums,
+                               Bound bound, double* out) {
+  double result[kWindows] = {};
+  std::uint64_t mask[kWindows][2] = {};
+  std::size_t common = windows[0]->count;
+  for (std::size_t k = 1; k < kWindows; ++k) common = std::min(common, windows[k]->count);
+  auto add = [&](std::size_t k, std::size_t j) {
+    const MassInterval& cell = windows[k]->cells[j];
+    const std::size_t position = std::size_t(windows[k]->first) + j;
+    result[k] += cell.lo * line[position];
+    const std::uint32_t r = rank[position];
+    const std::uint64_t slack = cell.hi - cell.lo > 0.0;
+    mask[k][0] |= r < 64 ? slack << r : 0;
+    mask[k][1] |= r < 64 ? 0 : slack << (r - 64);
+  };
+  for (std::size_t j = 0; j < common; ++j)
+    for (std::size_t k = 0; k < kWindows; ++k) add(k, j);
+  const double cut = cut_value(bound);
+  for (std::size_t k = 0; k < kWindows; ++k) {
+    for (std::size_t j = common; j < windows[k]->count; ++j) add(k, j);
+    result[k] += windows[k]->leave.lo * 0.0;
+    result[k] += windows[k]->cut.lo * cut;
+    out[k] = give_budget(result[k], line, order, length, *windows[k], *sums[k], bound, mask[k]);
+  }
+}
+
 }  // namespace
 
 double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
@@ -159,6 +190,20 @@ void ordered_expectations(const double* lines, const std::uint32_t* orders, cons
                                  bound);
 }
 
+void ordered_expectations_of_line(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                                  std::size_t length, const DimensionView* const* windows,
+                                  const WindowSums* const* sums, std::size_t window_count, Bound bound, double* out) {
+  constexpr std::size_t kBatch = 4;
+  for (std::size_t k = 0; k < window_count; ++k)
+    require(windows[k]->first >= 0 && std::size_t(windows[k]->first) + windows[k]->count <= length,
+            "a window inside its line");
+  std::size_t k = 0;
+  if (length <= 128)
+    for (; k + kBatch <= window_count; k += kBatch)
+      line_windows_expectations<kBatch>(line, order, rank, length, windows + k, sums + k, bound, out + k);
+  for (; k < window_count; ++k) out[k] = ordered_expectation(line, order, rank, length, *windows[k], *sums[k], bound);
+}
+
 bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
   constexpr std::size_t kLinesPerRow = 64;
   std::size_t entries = 0, prefixes = 1;
@@ -192,21 +237,22 @@ ProductSweep::ProductSweep(const Grid& states, const RowBounds& rows, Bound boun
   }
 }
 
+void sort_line(const double* values, std::size_t length, Bound bound, std::uint32_t* order, std::uint32_t* rank) {
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  std::iota(order, order + length, 0u);
+  std::stable_sort(order, order + length,
+                   [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; });
+  for (std::size_t r = 0; r < length; ++r) rank[order[r]] = std::uint32_t(r);
+}
+
 void sort_lines(const double* lines, std::size_t count, std::size_t length, Bound bound, unsigned threads,
                 LineOrder& sorted) {
   sorted.order.resize(count * length);
   sorted.rank.resize(count * length);
-  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
   parallel_for(count, threads, [&](unsigned, std::size_t first, std::size_t last) {
-    for (std::size_t line = first; line < last; ++line) {
-      const double* values = lines + line * length;
-      std::uint32_t* positions = sorted.order.data() + line * length;
-      std::iota(positions, positions + length, 0u);
-      std::stable_sort(positions, positions + length,
-                       [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; });
-      std::uint32_t* ranks = sorted.rank.data() + line * length;
-      for (std::size_t r = 0; r < length; ++r) ranks[positions[r]] = std::uint32_t(r);
-    }
+    for (std::size_t line = first; line < last; ++line)
+      sort_line(lines + line * length, length, bound, sorted.order.data() + line * length,
+                sorted.rank.data() + line * length);
   });
 }
 

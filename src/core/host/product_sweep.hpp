@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "amytiss/grid.hpp"
+#include "common/host_memory.hpp"
 #include "host/interval_bellman.hpp"
 #include "host/row_bounds.hpp"
 
@@ -30,6 +31,11 @@ struct LineOrder {
   std::vector<std::uint32_t> order, rank;
 };
 
+/// Sorts one line of `length` values: order[r] is the position of the r-th value in `bound`'s
+/// filling order (increasing values for the lower bound, decreasing for the upper; stable), rank
+/// the inverse.
+void sort_line(const double* values, std::size_t length, Bound bound, std::uint32_t* order, std::uint32_t* rank);
+
 /// Sorts each of `count` lines of `length` values (line k at lines + k * length) into `sorted`:
 /// the positions in `bound`'s filling order (increasing values for the lower bound, decreasing
 /// for the upper; stable), on `threads` workers.
@@ -37,10 +43,11 @@ void sort_lines(const double* lines, std::size_t count, std::size_t length, Boun
                 LineOrder& sorted);
 
 /// What one ProductSweep::prepare() builds and its expectations read: the stage tables, the lines'
-/// sort orders and stage 0's running maxima. Every prepare() rebuilds all of it, so sweeps that
-/// never run at the same time (a step's lower and upper bound) can share one and touch half the
-/// memory.
+/// sort orders and stage 0's running maxima; or the stage tensors of a RobustFactoredSweep
+/// (host/robust_factored.hpp). Every prepare() rebuilds all of it, so sweeps that never run at the
+/// same time (a step's lower and upper bound) can share one and touch half the memory.
 struct SweepBuffers {
+  HostDoubles stage_tensors[2];             // the variable elimination's W_k, ping-pong
   std::vector<std::vector<double>> tables;  // per dimension d >= 1: [suffix class][prefix]
   LineOrder source_order;                   // the current stage's source lines' order
   LineOrder stage0_order;                   // stage 0's lines' order
@@ -106,5 +113,11 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
 void ordered_expectations(const double* lines, const std::uint32_t* orders, const std::uint32_t* ranks,
                           std::size_t length, std::size_t line_count, const DimensionView& window,
                           const WindowSums& sums, Bound bound, double* out);
+
+/// ordered_expectation() of one line with `window_count` windows (windows[k] with sums[k]) into
+/// out[0..window_count): the same results, bit for bit, several windows at a time.
+void ordered_expectations_of_line(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
+                                  std::size_t length, const DimensionView* const* windows,
+                                  const WindowSums* const* sums, std::size_t window_count, Bound bound, double* out);
 
 }  // namespace amytiss::detail

@@ -32,11 +32,10 @@ void variable_digits(const Abstraction& a, std::size_t cell, std::size_t input, 
 }  // namespace
 
 std::optional<FactoredPlan> RobustFactoredSweep::plan(const Abstraction& a, std::string* reason) {
-  // The plan counts its tensors, Q and tables; the sorted lines take as much again as a tensor.
-  std::optional<FactoredPlan> plan = plan_factored_sweep(a, kMaxBytes / 2, kMaxBytes / 4, reason);
+  std::optional<FactoredPlan> plan = plan_factored_sweep(a, kMaxBytes, kMaxBytes / 2, reason);
   if (plan && plan->slices > 1) {
     if (reason)
-      *reason = "its tensors need " + std::to_string(plan->slices) + " slices within " + format_bytes(kMaxBytes / 2) +
+      *reason = "its tensors need " + std::to_string(plan->slices) + " slices within " + format_bytes(kMaxBytes) +
                 " (an O-maximisation needs its whole line)";
     return std::nullopt;
   }
@@ -44,8 +43,10 @@ std::optional<FactoredPlan> RobustFactoredSweep::plan(const Abstraction& a, std:
 }
 
 RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& rows, const std::vector<bool>& has_rows,
-                                         FactoredPlan plan, Bound bound, unsigned threads)
-    : plan_(std::move(plan)), bound_(bound), threads_(threads) {
+                                         FactoredPlan plan, Bound bound, unsigned threads,
+                                         std::shared_ptr<SweepBuffers> buffers)
+    : plan_(std::move(plan)), bound_(bound), threads_(threads), buffers_(std::move(buffers)) {
+  if (!buffers_) buffers_ = std::make_shared<SweepBuffers>();
   require(plan_.slices == 1 && plan_.stages.size() == a.states.dims(), "a plan of one slice, a stage per dimension");
   for (std::size_t d = 0; d < a.states.dims(); ++d) counts_.push_back(a.states.count(d));
   gather_windows(a, rows, has_rows);
@@ -105,56 +106,87 @@ void RobustFactoredSweep::prepare(const double* values) {
   const double* in = values;
   std::size_t in_size = 1;
   for (std::size_t count : counts_) in_size *= count;
+  q_.resize(plan_.stages.back().output_size);
   for (std::size_t k = 0; k < plan_.stages.size(); ++k) {
-    std::vector<double>& out = k + 1 == plan_.stages.size() ? q_ : tensors_[k % 2];
-    out.resize(plan_.stages[k].output_size);
-    run_stage(k, in, in_size, out.data());
-    in = out.data();
-    in_size = out.size();
+    const std::size_t out_size = plan_.stages[k].output_size;
+    double* out = k + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[k % 2].reserve(out_size);
+    run_stage(k, in, in_size, out);
+    in = out;
+    in_size = out_size;
   }
 }
+
+namespace {
+
+// A stage's output digits split by what they do: those the input has name the line an entry
+// reads; the others enumerate the tuples applied to that line (row-major, as the output).
+struct StageWalk {
+  struct Carried {
+    std::size_t radix, input_stride, output_stride, tuple_stride;
+  };
+  std::vector<Carried> carried;
+  std::vector<std::size_t> free_offsets, free_tuples;  // per combination of the other digits
+};
+
+StageWalk stage_walk(const FactoredStage& stage) {
+  StageWalk walk;
+  walk.free_offsets.assign(1, 0);
+  walk.free_tuples.assign(1, 0);
+  std::size_t output_stride = stage.output_size;
+  for (std::size_t j = 0; j < stage.output.size(); ++j) {
+    const std::size_t radix = stage.output[j].radix;
+    output_stride /= radix;
+    const auto tuple_stride = std::size_t(stage.tuple_stride[j]);
+    if (stage.input_stride[j]) {
+      walk.carried.push_back({radix, std::size_t(stage.input_stride[j]), output_stride, tuple_stride});
+      continue;
+    }
+    std::vector<std::size_t> offsets, tuples;
+    for (std::size_t i = 0; i < walk.free_offsets.size(); ++i)
+      for (std::size_t digit = 0; digit < radix; ++digit) {
+        offsets.push_back(walk.free_offsets[i] + digit * output_stride);
+        tuples.push_back(walk.free_tuples[i] + digit * tuple_stride);
+      }
+    walk.free_offsets.swap(offsets);
+    walk.free_tuples.swap(tuples);
+  }
+  return walk;
+}
+
+}  // namespace
 
 void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t in_size, double* out) {
   const FactoredStage& stage = plan_.stages[k];
   const std::size_t dim = stage.dimension, length = counts_[dim];
   const std::size_t stride = std::size_t(stage.contracted_stride), lines = in_size / length;
-  // Line (high, low) of the input holds the entries high * stride * length + low + a * stride: its
-  // values side by side, then sorted once for every tuple applied to it.
-  lines_.resize(in_size);
-  parallel_for(lines, threads_, [&](unsigned, std::size_t first, std::size_t last) {
-    for (std::size_t line = first; line < last; ++line) {
-      const std::size_t base = (line / stride) * stride * length + line % stride;
-      for (std::size_t a = 0; a < length; ++a) lines_[line * length + a] = in[base + a * stride];
-    }
-  });
-  sort_lines(lines_.data(), lines, length, bound_, threads_, line_order_);
+  const StageWalk walk = stage_walk(stage);
+  const std::size_t applied = walk.free_offsets.size();
+  require(lines * applied == stage.output_size, "every output entry reads one line");
   const std::vector<DimensionView>& windows = windows_[dim];
   const std::vector<WindowSums>& sums = sums_[dim];
-  const std::size_t digits = stage.output.size();
-  parallel_for(std::size_t(stage.output_size), threads_, [&](unsigned, std::size_t first, std::size_t last) {
-    // The output entry's digits, its line's base in the input and its tuple, carried along.
-    std::vector<std::size_t> digit(digits);
-    std::size_t rest = first, base = 0, tuple = 0;
-    for (std::size_t j = digits; j-- > 0;) {
-      digit[j] = rest % stage.output[j].radix;
-      rest /= stage.output[j].radix;
-      base += digit[j] * std::size_t(stage.input_stride[j]);
-      tuple += digit[j] * std::size_t(stage.tuple_stride[j]);
-    }
-    for (std::size_t entry = first; entry < last; ++entry) {
-      const std::size_t line = (base / (stride * length)) * stride + base % stride;
-      out[entry] = ordered_expectation(lines_.data() + line * length, line_order_.order.data() + line * length,
-                                       line_order_.rank.data() + line * length, length, windows[tuple], sums[tuple],
-                                       bound_);
-      for (std::size_t j = digits; j-- > 0;) {
-        const std::size_t radix = stage.output[j].radix;
-        base += std::size_t(stage.input_stride[j]);
-        tuple += std::size_t(stage.tuple_stride[j]);
-        if (++digit[j] < radix) break;
-        base -= radix * std::size_t(stage.input_stride[j]);
-        tuple -= radix * std::size_t(stage.tuple_stride[j]);
-        digit[j] = 0;
+  parallel_for(lines, threads_, [&](unsigned, std::size_t first, std::size_t last) {
+    std::vector<double> line(length), results(applied);
+    std::vector<std::uint32_t> order(length), rank(length);
+    std::vector<const DimensionView*> line_windows(applied);
+    std::vector<const WindowSums*> line_sums(applied);
+    for (std::size_t index = first; index < last; ++index) {
+      // Line `index` holds the input entries base + a * stride.
+      const std::size_t base = (index / stride) * stride * length + index % stride;
+      std::size_t output_base = 0, tuple_base = 0;
+      for (const StageWalk::Carried& digit : walk.carried) {
+        const std::size_t value = base / digit.input_stride % digit.radix;
+        output_base += value * digit.output_stride;
+        tuple_base += value * digit.tuple_stride;
       }
+      for (std::size_t a = 0; a < length; ++a) line[a] = in[base + a * stride];
+      sort_line(line.data(), length, bound_, order.data(), rank.data());
+      for (std::size_t i = 0; i < applied; ++i) {
+        line_windows[i] = &windows[tuple_base + walk.free_tuples[i]];
+        line_sums[i] = &sums[tuple_base + walk.free_tuples[i]];
+      }
+      ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, line_windows.data(),
+                                   line_sums.data(), applied, bound_, results.data());
+      for (std::size_t i = 0; i < applied; ++i) out[output_base + walk.free_offsets[i]] = results[i];
     }
   });
 }

@@ -6,7 +6,8 @@
 // where the window and its interval masses are post dimension e_k's for the tuple of components
 // e_k reads (the bounds of any row with those components: host/row_bounds.hpp), leave worth 0 and
 // cut worth cut_value(bound), and Q = W_d holds every (cell, input, disturbance)'s bound. Each line
-// of W_{k-1} is sorted once for all the tuples applied to it (ordered_expectation()).
+// of W_{k-1} is read once: sorted, then every tuple applied to it (ordered_expectation()), so the
+// stage keeps no sorted copy of its input.
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
 // stage may pick its distribution per remaining cell, a superset of the product set), and equal,
@@ -14,6 +15,7 @@
 // coordinates read few components (building automation: 7 dimensions, each reading 2 to 4), where
 // the row-by-row product bound recomputes the same lines for every row.
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,15 +30,18 @@ namespace amytiss::detail {
 
 class RobustFactoredSweep {
  public:
-  /// At most this many bytes for the tensors, the sorted lines and Q.
+  /// At most this many bytes for the tensors, Q and the mass tables (half of it for one tensor).
   static constexpr double kMaxBytes = 2.0 * (1 << 30);
   /// The factored sweep's plan for these bounds, or nullopt with the reason: no plan (dynamics
   /// without dependencies, full covariance), or one that needs slices (an O-maximisation needs
   /// its whole line) or more than kMaxBytes.
   static std::optional<FactoredPlan> plan(const Abstraction& abstraction, std::string* reason);
-  /// `rows` must hold the rows of every cell with `has_rows` true; `plan` from plan().
+  /// `rows` must hold the rows of every cell with `has_rows` true; `plan` from plan(). `buffers`
+  /// (the stage tensors): shared with sweeps that never run at the same time as this one; null:
+  /// its own.
   RobustFactoredSweep(const Abstraction& abstraction, const RowBounds& rows, const std::vector<bool>& has_rows,
-                      FactoredPlan plan, Bound bound, unsigned threads);
+                      FactoredPlan plan, Bound bound, unsigned threads,
+                      std::shared_ptr<SweepBuffers> buffers = nullptr);
   /// Every stage over `values` (one per state cell, flat): Q.
   void prepare(const double* values);
   /// The bound of row (cell, input, disturbance) over the values of the last prepare().
@@ -60,8 +65,8 @@ class RobustFactoredSweep {
   std::vector<std::size_t> counts_;                  // state cells per dimension
   std::vector<std::vector<DimensionView>> windows_;  // [dimension][tuple]
   std::vector<std::vector<WindowSums>> sums_;        // [dimension][tuple]
-  std::vector<double> tensors_[2], q_, lines_;       // ping-pong W_k, Q, the current stage's lines
-  LineOrder line_order_;
+  std::shared_ptr<SweepBuffers> buffers_;            // the ping-pong W_k
+  std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;
 };
 

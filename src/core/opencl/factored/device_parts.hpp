@@ -9,7 +9,7 @@
 #include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
 #include "host/factored_plan.hpp"
-#include "opencl/host_memory.hpp"
+#include "common/host_memory.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {
@@ -57,7 +57,7 @@ struct FactoredBuffers {
   Buffer roles, values[2], best_input, q, stage_tensors[2];
   std::size_t device_bytes = 0;
 };
-/// `cpu_device`: Q and the stage tensors live in HostBlocks (opencl/host_memory.hpp).
+/// `cpu_device`: Q and the stage tensors live in HostBlocks (common/host_memory.hpp).
 FactoredBuffers allocate_factored_buffers(const Abstraction& abstraction, const FactoredPlan& plan,
                                           const std::vector<MassTable>& tables, cl_context context, bool cpu_device);
 /// V_{T_d} per state, then kTensorSlack zero cells.

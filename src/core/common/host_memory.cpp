@@ -1,4 +1,4 @@
-#include "opencl/host_memory.hpp"
+#include "common/host_memory.hpp"
 
 #include <sys/mman.h>
 
@@ -21,5 +21,14 @@ HostBlock::HostBlock(std::size_t bytes) {
 }
 
 void HostBlock::Free::operator()(void* data) const { std::free(data); }
+
+double* HostDoubles::reserve(std::size_t count) {
+  if (count > capacity_) {
+    block_.reset();  // the old block goes before the new one is taken
+    block_ = std::make_unique<HostBlock>(count * sizeof(double));
+    capacity_ = count;
+  }
+  return data();
+}
 
 }  // namespace amytiss::detail
