@@ -15,6 +15,8 @@ void require(bool invariant, const char* what) {
 
 // Lines up to this long visit only the window's cells (a bit per rank).
 constexpr std::size_t kMaskBits = 256;
+// Lines up to this long are sorted by insertion.
+constexpr std::size_t kInsertionSortLength = 32;
 
 }  // namespace
 
@@ -206,9 +208,19 @@ void ordered_expectations_of_line(const double* line, const std::uint32_t* order
 
 void sort_line(const double* values, std::size_t length, Bound bound, std::uint32_t* order, std::uint32_t* rank) {
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  auto before = [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; };
   std::iota(order, order + length, 0u);
-  std::stable_sort(order, order + length,
-                   [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; });
+  if (length <= kInsertionSortLength) {
+    // Short lines: an insertion sort (stable) without stable_sort's buffer.
+    for (std::size_t i = 1; i < length; ++i) {
+      const std::uint32_t position = order[i];
+      std::size_t j = i;
+      for (; j > 0 && before(position, order[j - 1]); --j) order[j] = order[j - 1];
+      order[j] = position;
+    }
+  } else {
+    std::stable_sort(order, order + length, before);
+  }
   for (std::size_t r = 0; r < length; ++r) rank[order[r]] = std::uint32_t(r);
 }
 

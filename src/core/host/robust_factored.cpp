@@ -1,5 +1,6 @@
 #include "host/robust_factored.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "amytiss/format.hpp"
@@ -124,7 +125,7 @@ struct StageWalk {
   struct Carried {
     std::size_t radix, input_stride, output_stride, tuple_stride;
   };
-  std::vector<Carried> carried;
+  std::vector<Carried> carried;  // by increasing input stride: the lines' odometer, fastest first
   std::vector<std::size_t> free_offsets, free_tuples;  // per combination of the other digits
 };
 
@@ -150,6 +151,8 @@ StageWalk stage_walk(const FactoredStage& stage) {
     walk.free_offsets.swap(offsets);
     walk.free_tuples.swap(tuples);
   }
+  std::sort(walk.carried.begin(), walk.carried.end(),
+            [](const StageWalk::Carried& a, const StageWalk::Carried& b) { return a.input_stride < b.input_stride; });
   return walk;
 }
 
@@ -169,15 +172,18 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
     std::vector<std::uint32_t> order(length), rank(length);
     std::vector<const DimensionView*> line_windows(applied);
     std::vector<const WindowSums*> line_sums(applied);
+    // The carried digits of line `first`, then counted up line by line: consecutive lines are
+    // consecutive values of the carried digits, fastest first (no division per line).
+    const std::size_t first_base = (first / stride) * stride * length + first % stride;
+    std::vector<std::size_t> digits;
+    std::size_t base = 0, output_base = 0, tuple_base = 0;
+    for (const StageWalk::Carried& digit : walk.carried) {
+      digits.push_back(first_base / digit.input_stride % digit.radix);
+      base += digits.back() * digit.input_stride;
+      output_base += digits.back() * digit.output_stride;
+      tuple_base += digits.back() * digit.tuple_stride;
+    }
     for (std::size_t index = first; index < last; ++index) {
-      // Line `index` holds the input entries base + a * stride.
-      const std::size_t base = (index / stride) * stride * length + index % stride;
-      std::size_t output_base = 0, tuple_base = 0;
-      for (const StageWalk::Carried& digit : walk.carried) {
-        const std::size_t value = base / digit.input_stride % digit.radix;
-        output_base += value * digit.output_stride;
-        tuple_base += value * digit.tuple_stride;
-      }
       for (std::size_t a = 0; a < length; ++a) line[a] = in[base + a * stride];
       sort_line(line.data(), length, bound_, order.data(), rank.data());
       for (std::size_t i = 0; i < applied; ++i) {
@@ -187,6 +193,17 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
       ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, line_windows.data(),
                                    line_sums.data(), applied, bound_, results.data());
       for (std::size_t i = 0; i < applied; ++i) out[output_base + walk.free_offsets[i]] = results[i];
+      for (std::size_t j = 0; j < walk.carried.size(); ++j) {
+        const StageWalk::Carried& digit = walk.carried[j];
+        base += digit.input_stride;
+        output_base += digit.output_stride;
+        tuple_base += digit.tuple_stride;
+        if (++digits[j] < digit.radix) break;
+        base -= digit.radix * digit.input_stride;
+        output_base -= digit.radix * digit.output_stride;
+        tuple_base -= digit.radix * digit.tuple_stride;
+        digits[j] = 0;
+      }
     }
   });
 }
