@@ -76,9 +76,16 @@ double give_budget(double result, const double* line, const std::uint32_t* order
         give_extras_below(sign * value);
         if (!(budget > 0.0)) break;
         const MassInterval& cell = cells[position - first];  // in the window, with slack
-        const double given = std::min(cell.hi - cell.lo, budget);
-        result += given * value;
-        budget -= given;
+        const double slack = cell.hi - cell.lo;
+        // min(slack, budget) as a branch: while the whole slack fits, the budget's chain of
+        // dependent operations is one subtraction per cell.
+        if (slack < budget) {
+          result += slack * value;
+          budget -= slack;
+        } else {
+          result += budget * value;
+          budget = 0.0;
+        }
       }
     }
   } else {
