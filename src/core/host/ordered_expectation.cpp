@@ -53,7 +53,8 @@ double give_budget(double result, const double* line, const std::uint32_t* order
     double key, value, slack;
   };
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;
-  const Extra leave{0.0, 0.0, window.leave.hi - window.leave.lo}, cut_mass{sign * cut, cut, window.cut.hi - window.cut.lo};
+  const Extra leave{0.0, 0.0, window.leave.hi - window.leave.lo};
+  const Extra cut_mass{sign * cut, cut, window.cut.hi - window.cut.lo};
   const Extra extras[2] = {bound == Bound::Lower ? leave : cut_mass, bound == Bound::Lower ? cut_mass : leave};
   std::size_t next_extra = 0;
   double budget = 1.0 - sums.lo;
