@@ -1,6 +1,7 @@
 #include "host/robust_factored.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 
 #include "amytiss/format.hpp"
@@ -167,42 +168,50 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
   require(lines * applied == stage.output_size, "every output entry reads one line");
   const std::vector<DimensionView>& windows = windows_[dim];
   const std::vector<WindowSums>& sums = sums_[dim];
-  parallel_for(lines, threads_, [&](unsigned, std::size_t first, std::size_t last) {
+  // Workers take chunks of lines as they go: lines differ in cost (the walks' lengths), and an
+  // even split would leave a worker idle at the end of the stage.
+  const std::size_t chunk = std::clamp<std::size_t>(lines / (16 * std::size_t(threads_)), 1, 256);
+  std::atomic<std::size_t> next_line{0};
+  parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
     std::vector<double> line(length), results(applied);
     std::vector<std::uint32_t> order(length), rank(length);
     std::vector<const DimensionView*> line_windows(applied);
     std::vector<const WindowSums*> line_sums(applied);
-    // The carried digits of line `first`, then counted up line by line: consecutive lines are
-    // consecutive values of the carried digits, fastest first (no division per line).
-    const std::size_t first_base = (first / stride) * stride * length + first % stride;
     std::vector<std::size_t> digits;
-    std::size_t base = 0, output_base = 0, tuple_base = 0;
-    for (const StageWalk::Carried& digit : walk.carried) {
-      digits.push_back(first_base / digit.input_stride % digit.radix);
-      base += digits.back() * digit.input_stride;
-      output_base += digits.back() * digit.output_stride;
-      tuple_base += digits.back() * digit.tuple_stride;
-    }
-    for (std::size_t index = first; index < last; ++index) {
-      for (std::size_t a = 0; a < length; ++a) line[a] = in[base + a * stride];
-      sort_line(line.data(), length, bound_, order.data(), rank.data());
-      for (std::size_t i = 0; i < applied; ++i) {
-        line_windows[i] = &windows[tuple_base + walk.free_tuples[i]];
-        line_sums[i] = &sums[tuple_base + walk.free_tuples[i]];
+    for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
+      const std::size_t last = std::min(first + chunk, lines);
+      // The carried digits of line `first`, then counted up line by line: consecutive lines are
+      // consecutive values of the carried digits, fastest first (no division per line).
+      const std::size_t first_base = (first / stride) * stride * length + first % stride;
+      digits.clear();
+      std::size_t base = 0, output_base = 0, tuple_base = 0;
+      for (const StageWalk::Carried& digit : walk.carried) {
+        digits.push_back(first_base / digit.input_stride % digit.radix);
+        base += digits.back() * digit.input_stride;
+        output_base += digits.back() * digit.output_stride;
+        tuple_base += digits.back() * digit.tuple_stride;
       }
-      ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, line_windows.data(),
-                                   line_sums.data(), applied, bound_, results.data());
-      for (std::size_t i = 0; i < applied; ++i) out[output_base + walk.free_offsets[i]] = results[i];
-      for (std::size_t j = 0; j < walk.carried.size(); ++j) {
-        const StageWalk::Carried& digit = walk.carried[j];
-        base += digit.input_stride;
-        output_base += digit.output_stride;
-        tuple_base += digit.tuple_stride;
-        if (++digits[j] < digit.radix) break;
-        base -= digit.radix * digit.input_stride;
-        output_base -= digit.radix * digit.output_stride;
-        tuple_base -= digit.radix * digit.tuple_stride;
-        digits[j] = 0;
+      for (std::size_t index = first; index < last; ++index) {
+        for (std::size_t a = 0; a < length; ++a) line[a] = in[base + a * stride];
+        sort_line(line.data(), length, bound_, order.data(), rank.data());
+        for (std::size_t i = 0; i < applied; ++i) {
+          line_windows[i] = &windows[tuple_base + walk.free_tuples[i]];
+          line_sums[i] = &sums[tuple_base + walk.free_tuples[i]];
+        }
+        ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, line_windows.data(),
+                                     line_sums.data(), applied, bound_, results.data());
+        for (std::size_t i = 0; i < applied; ++i) out[output_base + walk.free_offsets[i]] = results[i];
+        for (std::size_t j = 0; j < walk.carried.size(); ++j) {
+          const StageWalk::Carried& digit = walk.carried[j];
+          base += digit.input_stride;
+          output_base += digit.output_stride;
+          tuple_base += digit.tuple_stride;
+          if (++digits[j] < digit.radix) break;
+          base -= digit.radix * digit.input_stride;
+          output_base -= digit.radix * digit.output_stride;
+          tuple_base -= digit.radix * digit.tuple_stride;
+          digits[j] = 0;
+        }
       }
     }
   });
