@@ -149,10 +149,10 @@ TEST(ProductSweep, LinesAtOnceGiveEachLineItsOwnBitForBit) {
 
 TEST(ProductSweep, WindowsAtOnceOnOneLineGiveEachWindowItsOwnBitForBit) {
   std::mt19937 random(kSeed);
-  // 21 and 32: lines sorted by insertion; 41 and 128: batches of windows (masks of one and two
-  // words); 129 and 200: one at a time.
-  for (std::size_t length : {std::size_t(1), std::size_t(21), std::size_t(32), std::size_t(41), std::size_t(128),
-                             std::size_t(129), std::size_t(200)}) {
+  // 5: one run of the sort; 21 to 200: runs merged; 300: std::stable_sort. 41 and 128: batches
+  // of windows (masks of one and two words); 129 and above: one window at a time.
+  for (std::size_t length : {std::size_t(1), std::size_t(5), std::size_t(21), std::size_t(41), std::size_t(128),
+                             std::size_t(129), std::size_t(200), std::size_t(300)}) {
     for (std::size_t window_count = 1; window_count <= 9; ++window_count) {
       for (int trial = 0; trial < kRandomRows / 40; ++trial) {
         const std::vector<double> line = random_line(random, length);

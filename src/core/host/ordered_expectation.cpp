@@ -15,8 +15,10 @@ void require(bool invariant, const char* what) {
 
 // Lines up to this long visit only the window's cells (a bit per rank).
 constexpr std::size_t kMaskBits = 256;
-// Lines up to this long are sorted by insertion.
-constexpr std::size_t kInsertionSortLength = 32;
+// Lines up to this long are sorted here (runs of kRunLength by insertion, then merged), longer
+// ones by std::stable_sort.
+constexpr std::size_t kMergeSortLength = 256;
+constexpr std::size_t kRunLength = 8;
 
 }  // namespace
 
@@ -216,18 +218,42 @@ void ordered_expectations_of_line(const double* line, const std::uint32_t* order
 
 void sort_line(const double* values, std::size_t length, Bound bound, std::uint32_t* order, std::uint32_t* rank) {
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;
-  auto before = [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; };
-  std::iota(order, order + length, 0u);
-  if (length <= kInsertionSortLength) {
-    // Short lines: an insertion sort (stable) without stable_sort's buffer.
-    for (std::size_t i = 1; i < length; ++i) {
-      const std::uint32_t position = order[i];
-      std::size_t j = i;
-      for (; j > 0 && before(position, order[j - 1]); --j) order[j] = order[j - 1];
-      order[j] = position;
-    }
+  if (length > kMergeSortLength) {
+    std::iota(order, order + length, 0u);
+    std::stable_sort(order, order + length,
+                     [&](std::uint32_t a, std::uint32_t b) { return sign * values[a] < sign * values[b]; });
   } else {
-    std::stable_sort(order, order + length, before);
+    double keys[kMergeSortLength];
+    for (std::size_t j = 0; j < length; ++j) keys[j] = sign * values[j];
+    // Runs of kRunLength by insertion, then merges between `order` and a buffer; a merge takes
+    // the right element only when its key is smaller (stable), chosen without a branch, which a
+    // merge of unordered keys mispredicts half the time.
+    std::uint32_t buffer[kMergeSortLength];
+    for (std::size_t run = 0; run < length; run += kRunLength) {
+      const std::size_t end = std::min(run + kRunLength, length);
+      for (std::size_t i = run; i < end; ++i) {
+        std::size_t j = i;
+        for (; j > run && keys[i] < keys[order[j - 1]]; --j) order[j] = order[j - 1];
+        order[j] = std::uint32_t(i);
+      }
+    }
+    std::uint32_t *from = order, *to = buffer;
+    for (std::size_t width = kRunLength; width < length; width *= 2) {
+      for (std::size_t left = 0; left < length; left += 2 * width) {
+        const std::size_t middle = std::min(left + width, length), end = std::min(left + 2 * width, length);
+        std::size_t i = left, j = middle, out = left;
+        while (i < middle && j < end) {
+          const bool right = keys[from[j]] < keys[from[i]];
+          to[out++] = right ? from[j] : from[i];
+          j += right;
+          i += !right;
+        }
+        while (i < middle) to[out++] = from[i++];
+        while (j < end) to[out++] = from[j++];
+      }
+      std::swap(from, to);
+    }
+    if (from != order) std::copy(from, from + length, order);
   }
   for (std::size_t r = 0; r < length; ++r) rank[order[r]] = std::uint32_t(r);
 }
