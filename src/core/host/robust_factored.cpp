@@ -169,8 +169,9 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
   const std::vector<DimensionView>& windows = windows_[dim];
   const std::vector<WindowSums>& sums = sums_[dim];
   // Workers take chunks of lines as they go: lines differ in cost (the walks' lengths), and an
-  // even split would leave a worker idle at the end of the stage.
-  const std::size_t chunk = std::clamp<std::size_t>(lines / (16 * std::size_t(threads_)), 1, 256);
+  // even split would leave a worker idle at the end of the stage. At least 16 lines a chunk: a
+  // chunk finds its first line's digits by division, the others by counting.
+  const std::size_t chunk = std::clamp<std::size_t>(lines / (16 * std::size_t(threads_)), 16, 256);
   std::atomic<std::size_t> next_line{0};
   parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
     std::vector<double> line(length), results(applied);
