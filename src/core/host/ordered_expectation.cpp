@@ -19,6 +19,8 @@ constexpr std::size_t kMaskBits = 256;
 // ones by std::stable_sort.
 constexpr std::size_t kMergeSortLength = 256;
 constexpr std::size_t kRunLength = 8;
+// Lines with at least this many windows take their masks from RankRuns.
+constexpr std::size_t kWindowsForRankRuns = 16;
 
 }  // namespace
 
@@ -130,21 +132,55 @@ void short_lines_expectations(const double* lines, const std::uint32_t* orders, 
   }
 }
 
+// The rank bits of every run of a line's positions (lines up to 128 long): bits[level][position]
+// has a bit at the rank of each of positions position .. position + 2^level - 1 (two words), so
+// that a window's mask is two lookups. Such a mask also holds the window's cells without slack;
+// the filling gives them 0 (min(0, budget), added as 0 * value), which leaves its result and
+// budget the same bit for bit, as long as no cell has hi < lo.
+class RankRuns {
+ public:
+  RankRuns(const std::uint32_t* rank, std::size_t length) {
+    for (std::size_t position = 0; position < length; ++position) {
+      const std::uint32_t r = rank[position];
+      bits_[0][position][0] = r < 64 ? std::uint64_t(1) << r : 0;
+      bits_[0][position][1] = r < 64 ? 0 : std::uint64_t(1) << (r - 64);
+    }
+    for (std::size_t level = 1; (std::size_t(1) << level) <= length; ++level)
+      for (std::size_t position = 0; position + (std::size_t(1) << level) <= length; ++position)
+        for (std::size_t word = 0; word < 2; ++word)
+          bits_[level][position][word] =
+              bits_[level - 1][position][word] | bits_[level - 1][position + (std::size_t(1) << (level - 1))][word];
+  }
+  // The bits of positions first .. first + count - 1 (count > 0) into mask[0..2).
+  void mask_of(std::size_t first, std::size_t count, std::uint64_t* mask) const {
+    const std::size_t level = std::size_t(63 - __builtin_clzll(count)), last = first + count - (std::size_t(1) << level);
+    for (std::size_t word = 0; word < 2; ++word) mask[word] = bits_[level][first][word] | bits_[level][last][word];
+  }
+
+ private:
+  static constexpr std::size_t kLevels = 8;  // runs up to 128 positions
+  std::uint64_t bits_[kLevels][128][2];
+};
+
 // ordered_expectation() of kWindows windows of one line at most 128 long: the sums at the lower
 // bounds are independent chains of additions, which the processor overlaps, and each window's
-// mask of ranks stays in two registers.
+// mask of ranks stays in two registers (from `runs` where given, else built cell by cell).
 template <std::size_t kWindows>
 void line_windows_expectations(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
                                std::size_t length, const DimensionView* const* windows, const WindowSums* const* sums,
-                               Bound bound, double* out) {
+                               Bound bound, const RankRuns* runs, double* out) {
   double result[kWindows] = {};
   std::uint64_t mask[kWindows][2] = {};
   std::size_t common = windows[0]->count;
   for (std::size_t k = 1; k < kWindows; ++k) common = std::min(common, windows[k]->count);
+  if (runs)
+    for (std::size_t k = 0; k < kWindows; ++k)
+      if (windows[k]->count) runs->mask_of(std::size_t(windows[k]->first), windows[k]->count, mask[k]);
   auto add = [&](std::size_t k, std::size_t j) {
     const MassInterval& cell = windows[k]->cells[j];
     const std::size_t position = std::size_t(windows[k]->first) + j;
     result[k] += cell.lo * line[position];
+    if (runs) return;
     const std::uint32_t r = rank[position];
     const std::uint64_t slack = cell.hi - cell.lo > 0.0;
     mask[k][0] |= r < 64 ? slack << r : 0;
@@ -209,9 +245,17 @@ void ordered_expectations_of_line(const double* line, const std::uint32_t* order
     require(windows[k]->first >= 0 && std::size_t(windows[k]->first) + windows[k]->count <= length,
             "a window inside its line");
   std::size_t k = 0;
-  if (length <= 128)
+  auto batches = [&](const RankRuns* runs) {
     for (; k + kBatch <= window_count; k += kBatch)
-      line_windows_expectations<kBatch>(line, order, rank, length, windows + k, sums + k, bound, out + k);
+      line_windows_expectations<kBatch>(line, order, rank, length, windows + k, sums + k, bound, runs, out + k);
+  };
+  if (length <= 128 && window_count >= kWindowsForRankRuns) {
+    // Building the runs costs about as much as the masks of a few windows.
+    const RankRuns runs(rank, length);
+    batches(&runs);
+  } else if (length <= 128) {
+    batches(nullptr);
+  }
   for (; k < window_count; ++k) out[k] = ordered_expectation(line, order, rank, length, *windows[k], *sums[k], bound);
 }
 
