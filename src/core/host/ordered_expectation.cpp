@@ -153,7 +153,8 @@ class RankRuns {
   }
   // The bits of positions first .. first + count - 1 (count > 0) into mask[0..2).
   void mask_of(std::size_t first, std::size_t count, std::uint64_t* mask) const {
-    const std::size_t level = std::size_t(63 - __builtin_clzll(count)), last = first + count - (std::size_t(1) << level);
+    const std::size_t level = std::size_t(63 - __builtin_clzll(count));
+    const std::size_t last = first + count - (std::size_t(1) << level);
     for (std::size_t word = 0; word < 2; ++word) mask[word] = bits_[level][first][word] | bits_[level][last][word];
   }
 
