@@ -22,6 +22,12 @@ constexpr std::size_t kRunLength = 8;
 // Lines with at least this many windows take their masks from RankRuns.
 constexpr std::size_t kWindowsForRankRuns = 16;
 
+// Sets `bit` (0 or 1) at rank r (< 128) of a two-word mask.
+void set_rank_bit(std::uint64_t* mask, std::uint32_t r, std::uint64_t bit) {
+  mask[0] |= r < 64 ? bit << r : 0;
+  mask[1] |= r < 64 ? 0 : bit << (r - 64);
+}
+
 }  // namespace
 
 WindowSums window_sums(const DimensionView& window) {
@@ -63,11 +69,17 @@ double give_budget(double result, const double* line, const std::uint32_t* order
   std::size_t next_extra = 0;
   double budget = 1.0 - sums.lo;
   // An outcome with slack takes min(slack, budget); one without takes no part, as in
-  // robust_expectation().
+  // robust_expectation(). The minimum as a branch: while the whole slack fits, the budget's chain
+  // of dependent operations is one subtraction per outcome.
   auto give = [&](double value, double slack) {
-    const double given = slack > 0.0 ? std::min(slack, budget) : 0.0;
-    result += given * value;
-    budget -= given;
+    if (!(slack > 0.0)) return;
+    if (slack < budget) {
+      result += slack * value;
+      budget -= slack;
+    } else {
+      result += budget * value;
+      budget = 0.0;
+    }
   };
   auto give_extras_below = [&](double key) {
     for (; next_extra < 2 && extras[next_extra].key < key && budget > 0.0; ++next_extra)
@@ -80,17 +92,8 @@ double give_budget(double result, const double* line, const std::uint32_t* order
         const double value = line[position];
         give_extras_below(sign * value);
         if (!(budget > 0.0)) break;
-        const MassInterval& cell = cells[position - first];  // in the window, with slack
-        const double slack = cell.hi - cell.lo;
-        // min(slack, budget) as a branch: while the whole slack fits, the budget's chain of
-        // dependent operations is one subtraction per cell.
-        if (slack < budget) {
-          result += slack * value;
-          budget -= slack;
-        } else {
-          result += budget * value;
-          budget = 0.0;
-        }
+        const MassInterval& cell = cells[position - first];  // in the window
+        give(value, cell.hi - cell.lo);
       }
     }
   } else {
@@ -135,15 +138,13 @@ void short_lines_expectations(const double* lines, const std::uint32_t* orders, 
 // The rank bits of every run of a line's positions (lines up to 128 long): bits[level][position]
 // has a bit at the rank of each of positions position .. position + 2^level - 1 (two words), so
 // that a window's mask is two lookups. Such a mask also holds the window's cells without slack;
-// the filling gives them 0 (min(0, budget), added as 0 * value), which leaves its result and
-// budget the same bit for bit, as long as no cell has hi < lo.
+// the filling passes them over, as it does outcomes without slack anywhere.
 class RankRuns {
  public:
   RankRuns(const std::uint32_t* rank, std::size_t length) {
     for (std::size_t position = 0; position < length; ++position) {
-      const std::uint32_t r = rank[position];
-      bits_[0][position][0] = r < 64 ? std::uint64_t(1) << r : 0;
-      bits_[0][position][1] = r < 64 ? 0 : std::uint64_t(1) << (r - 64);
+      bits_[0][position][0] = bits_[0][position][1] = 0;
+      set_rank_bit(bits_[0][position], rank[position], 1);
     }
     for (std::size_t level = 1; (std::size_t(1) << level) <= length; ++level)
       for (std::size_t position = 0; position + (std::size_t(1) << level) <= length; ++position)
@@ -181,11 +182,7 @@ void line_windows_expectations(const double* line, const std::uint32_t* order, c
     const MassInterval& cell = windows[k]->cells[j];
     const std::size_t position = std::size_t(windows[k]->first) + j;
     result[k] += cell.lo * line[position];
-    if (runs) return;
-    const std::uint32_t r = rank[position];
-    const std::uint64_t slack = cell.hi - cell.lo > 0.0;
-    mask[k][0] |= r < 64 ? slack << r : 0;
-    mask[k][1] |= r < 64 ? 0 : slack << (r - 64);
+    if (!runs) set_rank_bit(mask[k], rank[position], cell.hi - cell.lo > 0.0);
   };
   for (std::size_t j = 0; j < common; ++j)
     for (std::size_t k = 0; k < kWindows; ++k) add(k, j);

@@ -52,8 +52,7 @@ void ordered_expectations(const double* lines, const std::uint32_t* orders, cons
                           const WindowSums& sums, Bound bound, double* out);
 
 /// ordered_expectation() of one line with `window_count` windows (windows[k] with sums[k]) into
-/// out[0..window_count): the same results, bit for bit, several windows at a time. Every cell of
-/// the windows has hi >= lo (as mass intervals do).
+/// out[0..window_count): the same results, bit for bit, several windows at a time.
 void ordered_expectations_of_line(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
                                   std::size_t length, const DimensionView* const* windows,
                                   const WindowSums* const* sums, std::size_t window_count, Bound bound, double* out);
