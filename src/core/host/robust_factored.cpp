@@ -53,6 +53,7 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
   for (std::size_t d = 0; d < a.states.dims(); ++d) counts_.push_back(a.states.count(d));
   gather_windows(a, rows, has_rows);
   number_q(a);
+  for (const FactoredStage& stage : plan_.stages) walks_.push_back(walk_of(stage));
 }
 
 void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
@@ -118,19 +119,7 @@ void RobustFactoredSweep::prepare(const double* values) {
   }
 }
 
-namespace {
-
-// A stage's output digits split by what they do: those the input has name the line an entry
-// reads; the others enumerate the tuples applied to that line (row-major, as the output).
-struct StageWalk {
-  struct Carried {
-    std::size_t radix, input_stride, output_stride, tuple_stride;
-  };
-  std::vector<Carried> carried;  // by increasing input stride: the lines' odometer, fastest first
-  std::vector<std::size_t> free_offsets, free_tuples;  // per combination of the other digits
-};
-
-StageWalk stage_walk(const FactoredStage& stage) {
+RobustFactoredSweep::StageWalk RobustFactoredSweep::walk_of(const FactoredStage& stage) {
   StageWalk walk;
   walk.free_offsets.assign(1, 0);
   walk.free_tuples.assign(1, 0);
@@ -157,13 +146,11 @@ StageWalk stage_walk(const FactoredStage& stage) {
   return walk;
 }
 
-}  // namespace
-
 void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t in_size, double* out) {
   const FactoredStage& stage = plan_.stages[k];
   const std::size_t dim = stage.dimension, length = counts_[dim];
   const std::size_t stride = std::size_t(stage.contracted_stride), lines = in_size / length;
-  const StageWalk walk = stage_walk(stage);
+  const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
   require(lines * applied == stage.output_size, "every output entry reads one line");
   const std::vector<DimensionView>& windows = windows_[dim];

@@ -52,6 +52,16 @@ class RobustFactoredSweep {
   const std::vector<std::size_t>& order() const { return plan_.order; }
 
  private:
+  // A stage's output digits split by what they do: those the input has name the line an entry
+  // reads; the others enumerate the tuples applied to that line (row-major, as the output).
+  struct StageWalk {
+    struct Carried {
+      std::size_t radix, input_stride, output_stride, tuple_stride;
+    };
+    std::vector<Carried> carried;  // by increasing input stride: the lines' odometer, fastest first
+    std::vector<std::size_t> free_offsets, free_tuples;  // per combination of the other digits
+  };
+  static StageWalk walk_of(const FactoredStage& stage);
   // Stage k from `in` (W_{k-1}, `in_size` entries) into `out` (W_k).
   void run_stage(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Per post dimension, the window of each tuple of the components it reads (tuple digits major
@@ -65,6 +75,7 @@ class RobustFactoredSweep {
   std::vector<std::size_t> counts_;                  // state cells per dimension
   std::vector<std::vector<DimensionView>> windows_;  // [dimension][tuple]
   std::vector<std::vector<WindowSums>> sums_;        // [dimension][tuple]
+  std::vector<StageWalk> walks_;                     // per stage
   std::shared_ptr<SweepBuffers> buffers_;            // the ping-pong W_k
   std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;
