@@ -92,7 +92,8 @@ double IntervalStep::expectation(std::size_t row, const double* in, ProductScrat
 double IntervalStep::worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const {
   double worst = std::numeric_limits<double>::infinity();
   for (std::size_t w = 0; w < a_.disturbances.size(); ++w)
-    worst = std::min(worst, expectation(rows_.row(cell, input, w), in, scratch));
+    worst = std::min(worst, factored_ ? factored_->expectation(cell, input, w)
+                                      : expectation(rows_.row(cell, input, w), in, scratch));
   return worst;
 }
 
@@ -131,40 +132,6 @@ double IntervalStep::choose(std::size_t cell, const double* in, ProductScratch& 
   return best;
 }
 
-void IntervalStep::apply_factored(double* out, std::uint32_t* chosen, const std::uint32_t* controller) const {
-  parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
-    for (std::size_t cell = first; cell < last; ++cell) {
-      if (chosen) chosen[cell] = 0;
-      if (roles_[cell] != CellRole::Free) {
-        out[cell] = a_.terminal_value(roles_[cell]);
-        continue;
-      }
-      auto worst = [&](std::size_t input) {
-        double value = std::numeric_limits<double>::infinity();
-        for (std::size_t w = 0; w < a_.disturbances.size(); ++w)
-          value = std::min(value, factored_->expectation(cell, input, w));
-        return value;
-      };
-      if (controller) {
-        out[cell] = worst(controller[cell]);
-        continue;
-      }
-      // The maximiser with the lowest index.
-      double best = worst(0);
-      std::uint32_t best_input = 0;
-      for (std::size_t u = 1; u < a_.inputs.size(); ++u) {
-        const double value = worst(u);
-        if (value > best) {
-          best = value;
-          best_input = std::uint32_t(u);
-        }
-      }
-      out[cell] = best;
-      chosen[cell] = best_input;
-    }
-  });
-}
-
 void IntervalStep::prepare(const double* in) {
   if (factored_) return factored_->prepare(in);
   reset_stage_caches();
@@ -173,7 +140,6 @@ void IntervalStep::prepare(const double* in) {
 
 void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   prepare(in);
-  if (factored_) return apply_factored(out, chosen, nullptr);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);
@@ -193,7 +159,6 @@ void IntervalStep::apply(const double* in, double* out, std::uint32_t* chosen) {
 
 void IntervalStep::evaluate(const double* in, double* out, const std::uint32_t* controller) {
   prepare(in);
-  if (factored_) return apply_factored(out, nullptr, controller);
   parallel_for(a_.states.size(), threads_, [&](unsigned, std::size_t first, std::size_t last) {
     ProductScratch scratch;
     use_stage_caches(scratch);

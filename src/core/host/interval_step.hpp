@@ -41,10 +41,9 @@ class IntervalStep : public BellmanStep {
 
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;
+  // Min over disturbances of the rows' bounds: from the variable elimination's Q (after its
+  // prepare()) where there is one, else row by row.
   double worst_case(std::size_t cell, std::size_t input, const double* in, ProductScratch& scratch) const;
-  // The step from the factored sweep's Q (after its prepare()): every input of every Free cell,
-  // or the controller's input where `controller` is not null.
-  void apply_factored(double* out, std::uint32_t* chosen, const std::uint32_t* controller) const;
   // At least worst_case() (sweep only): min over disturbances of ProductSweep::upper_estimate().
   double estimate(std::size_t cell, std::size_t input) const;
   // The cell's best worst case over the inputs, and the input that gives it into `chosen`;
