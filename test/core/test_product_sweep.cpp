@@ -1,7 +1,7 @@
 // The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
-// ties, the leave and cut outcomes), and so do several lines at once and several windows on one
-// line (whose sort is the test's own); the sweep gives
+// ties, the leave and cut outcomes), and so do several lines at once; sort_line() is the stable
+// sort; the sweep gives
 // product_expectation()'s row by row, its estimate for the input choice is never below it, and
 // sweeps that share buffers give what each gives alone; rows that share a mean box through what
 // the map reads get the bounds they would compute themselves.
@@ -15,51 +15,17 @@
 #include "host/enclosure_mean_box.hpp"
 #include "host/product_sweep.hpp"
 #include "host/row_bounds.hpp"
+#include "random_rows.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {
 namespace {
 
 using namespace amytiss::test_support;
+using namespace amytiss::test_rows;
 
 constexpr unsigned kSeed = 20261202;
 constexpr int kRandomRows = 4000;
-
-// A random feasible window of `count` cells at `first` with leave and cut, values drawn from a few
-// levels (ties) including 0 and 1.
-struct RandomRow {
-  std::vector<MassInterval> cells;
-  DimensionView window;
-};
-
-RandomRow random_row(std::mt19937& random, std::size_t length) {
-  std::uniform_int_distribution<std::size_t> count_of(1, std::min<std::size_t>(length, 30));
-  RandomRow row;
-  const std::size_t count = count_of(random);
-  const std::size_t first = std::uniform_int_distribution<std::size_t>(0, length - count)(random);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<double> centre(count + 2);
-  for (double& mass : centre) mass = unit(random) < 0.2 ? 0.0 : unit(random);
-  centre[count] += 1e-3;  // some mass somewhere
-  const double total = std::accumulate(centre.begin(), centre.end(), 0.0);
-  std::vector<MassInterval> all;
-  for (double mass : centre) {
-    const double p = mass / total, width = unit(random) < 0.3 ? 0.0 : 0.2 * unit(random) * p + 1e-3 * unit(random);
-    all.push_back({std::max(0.0, p - width), std::min(1.0, p + width)});
-  }
-  // Sometimes leave or cut may take all the budget: the filling ends at them.
-  if (unit(random) < 0.2) all[count + std::size_t(unit(random) < 0.5)] = {0.0, 1.0};
-  row.cells.assign(all.begin(), all.begin() + std::ptrdiff_t(count));
-  row.window = {std::int64_t(first), count, nullptr, all[count], all[count + 1]};
-  return row;
-}
-
-std::vector<double> random_line(std::mt19937& random, std::size_t length) {
-  std::uniform_int_distribution<int> level(0, 6);
-  std::vector<double> line(length);
-  for (double& value : line) value = level(random) / 6.0;
-  return line;
-}
 
 // The line's filling order for `bound` (stable) and its inverse.
 void order_of(const std::vector<double>& line, Bound bound, std::vector<std::uint32_t>& order,
@@ -71,23 +37,6 @@ void order_of(const std::vector<double>& line, Bound bound, std::vector<std::uin
   std::stable_sort(order.begin(), order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return sign * line[a] < sign * line[b]; });
   for (std::size_t r = 0; r < order.size(); ++r) rank[order[r]] = std::uint32_t(r);
-}
-
-double sorted_expectation(const std::vector<double>& line, const RandomRow& row, Bound bound) {
-  std::vector<double> lo, hi, values;
-  for (std::size_t j = 0; j < row.cells.size(); ++j) {
-    lo.push_back(row.cells[j].lo);
-    hi.push_back(row.cells[j].hi);
-    values.push_back(line[std::size_t(row.window.first) + j]);
-  }
-  lo.push_back(row.window.leave.lo);
-  hi.push_back(row.window.leave.hi);
-  values.push_back(0.0);
-  lo.push_back(row.window.cut.lo);
-  hi.push_back(row.window.cut.hi);
-  values.push_back(cut_value(bound));
-  std::vector<OutcomeSlack> scratch;
-  return robust_expectation(lo.data(), hi.data(), values.data(), lo.size(), bound, scratch);
 }
 
 TEST(ProductSweep, OrderedExpectationIsTheSortedOneBitForBit) {
@@ -147,41 +96,19 @@ TEST(ProductSweep, LinesAtOnceGiveEachLineItsOwnBitForBit) {
   }
 }
 
-TEST(ProductSweep, WindowsAtOnceOnOneLineGiveEachWindowItsOwnBitForBit) {
+TEST(ProductSweep, SortLineIsTheStableSort) {
   std::mt19937 random(kSeed);
-  // 5: one run of the sort; 21 to 200: runs merged; 300: std::stable_sort. 41 and 128: batches
-  // of windows (masks of one and two words); 129 and above: one window at a time.
+  // 5: one run of insertion; 21 to 256: runs merged; 300: std::stable_sort.
   for (std::size_t length : {std::size_t(1), std::size_t(5), std::size_t(21), std::size_t(41), std::size_t(128),
-                             std::size_t(129), std::size_t(200), std::size_t(300)}) {
-    // 16 windows and more: the masks come from runs of rank bits (cells without slack included).
-    for (std::size_t window_count : {1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 17, 40}) {
-      for (int trial = 0; trial < kRandomRows / 40; ++trial) {
-        const std::vector<double> line = random_line(random, length);
-        std::vector<RandomRow> rows;
-        for (std::size_t k = 0; k < window_count; ++k) rows.push_back(random_row(random, length));
-        std::vector<const DimensionView*> windows;
-        std::vector<WindowSums> sums;
-        for (RandomRow& row : rows) {
-          row.window.cells = row.cells.data();
-          windows.push_back(&row.window);
-          sums.push_back(window_sums(row.window));
-        }
-        std::vector<const WindowSums*> sum_pointers;
-        for (const WindowSums& sum : sums) sum_pointers.push_back(&sum);
-        for (Bound bound : {Bound::Lower, Bound::Upper}) {
-          std::vector<std::uint32_t> order, rank, sorted_order(length), sorted_rank(length);
-          order_of(line, bound, order, rank);
-          sort_line(line.data(), length, bound, sorted_order.data(), sorted_rank.data());
-          ASSERT_EQ(sorted_order, order);
-          ASSERT_EQ(sorted_rank, rank);
-          std::vector<double> together(window_count);
-          ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, windows.data(),
-                                       sum_pointers.data(), window_count, bound, together.data());
-          for (std::size_t k = 0; k < window_count; ++k)
-            ASSERT_EQ(together[k], ordered_expectation(line.data(), order.data(), rank.data(), length, *windows[k],
-                                                       sums[k], bound))
-                << "length " << length << " windows " << window_count << " window " << k << " trial " << trial;
-        }
+                             std::size_t(200), std::size_t(256), std::size_t(300)}) {
+    for (int trial = 0; trial < kRandomRows / 40; ++trial) {
+      const std::vector<double> line = random_line(random, length);
+      for (Bound bound : {Bound::Lower, Bound::Upper}) {
+        std::vector<std::uint32_t> order, rank, sorted_order(length), sorted_rank(length);
+        order_of(line, bound, order, rank);
+        sort_line(line.data(), length, bound, sorted_order.data(), sorted_rank.data());
+        ASSERT_EQ(sorted_order, order) << "length " << length << " trial " << trial;
+        ASSERT_EQ(sorted_rank, rank) << "length " << length << " trial " << trial;
       }
     }
   }

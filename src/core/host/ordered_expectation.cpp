@@ -19,14 +19,6 @@ constexpr std::size_t kMaskBits = 256;
 // ones by std::stable_sort.
 constexpr std::size_t kMergeSortLength = 256;
 constexpr std::size_t kRunLength = 8;
-// Lines with at least this many windows take their masks from RankRuns.
-constexpr std::size_t kWindowsForRankRuns = 16;
-
-// Sets `bit` (0 or 1) at rank r (< 128) of a two-word mask.
-void set_rank_bit(std::uint64_t* mask, std::uint32_t r, std::uint64_t bit) {
-  mask[0] |= r < 64 ? bit << r : 0;
-  mask[1] |= r < 64 ? 0 : bit << (r - 64);
-}
 
 }  // namespace
 
@@ -135,66 +127,6 @@ void short_lines_expectations(const double* lines, const std::uint32_t* orders, 
   }
 }
 
-// The rank bits of every run of a line's positions (lines up to 128 long): bits[level][position]
-// has a bit at the rank of each of positions position .. position + 2^level - 1 (two words), so
-// that a window's mask is two lookups. Such a mask also holds the window's cells without slack;
-// the filling passes them over, as it does outcomes without slack anywhere.
-class RankRuns {
- public:
-  RankRuns(const std::uint32_t* rank, std::size_t length) {
-    for (std::size_t position = 0; position < length; ++position) {
-      bits_[0][position][0] = bits_[0][position][1] = 0;
-      set_rank_bit(bits_[0][position], rank[position], 1);
-    }
-    for (std::size_t level = 1; (std::size_t(1) << level) <= length; ++level)
-      for (std::size_t position = 0; position + (std::size_t(1) << level) <= length; ++position)
-        for (std::size_t word = 0; word < 2; ++word)
-          bits_[level][position][word] =
-              bits_[level - 1][position][word] | bits_[level - 1][position + (std::size_t(1) << (level - 1))][word];
-  }
-  // The bits of positions first .. first + count - 1 (count > 0) into mask[0..2).
-  void mask_of(std::size_t first, std::size_t count, std::uint64_t* mask) const {
-    const std::size_t level = std::size_t(63 - __builtin_clzll(count));
-    const std::size_t last = first + count - (std::size_t(1) << level);
-    for (std::size_t word = 0; word < 2; ++word) mask[word] = bits_[level][first][word] | bits_[level][last][word];
-  }
-
- private:
-  static constexpr std::size_t kLevels = 8;  // runs up to 128 positions
-  std::uint64_t bits_[kLevels][128][2];
-};
-
-// ordered_expectation() of kWindows windows of one line at most 128 long: the sums at the lower
-// bounds are independent chains of additions, which the processor overlaps, and each window's
-// mask of ranks stays in two registers (from `runs` where given, else built cell by cell).
-template <std::size_t kWindows>
-void line_windows_expectations(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                               std::size_t length, const DimensionView* const* windows, const WindowSums* const* sums,
-                               Bound bound, const RankRuns* runs, double* out) {
-  double result[kWindows] = {};
-  std::uint64_t mask[kWindows][2] = {};
-  std::size_t common = windows[0]->count;
-  for (std::size_t k = 1; k < kWindows; ++k) common = std::min(common, windows[k]->count);
-  if (runs)
-    for (std::size_t k = 0; k < kWindows; ++k)
-      if (windows[k]->count) runs->mask_of(std::size_t(windows[k]->first), windows[k]->count, mask[k]);
-  auto add = [&](std::size_t k, std::size_t j) {
-    const MassInterval& cell = windows[k]->cells[j];
-    const std::size_t position = std::size_t(windows[k]->first) + j;
-    result[k] += cell.lo * line[position];
-    if (!runs) set_rank_bit(mask[k], rank[position], cell.hi - cell.lo > 0.0);
-  };
-  for (std::size_t j = 0; j < common; ++j)
-    for (std::size_t k = 0; k < kWindows; ++k) add(k, j);
-  const double cut = cut_value(bound);
-  for (std::size_t k = 0; k < kWindows; ++k) {
-    for (std::size_t j = common; j < windows[k]->count; ++j) add(k, j);
-    result[k] += windows[k]->leave.lo * 0.0;
-    result[k] += windows[k]->cut.lo * cut;
-    out[k] = give_budget(result[k], line, order, length, *windows[k], *sums[k], bound, mask[k]);
-  }
-}
-
 }  // namespace
 
 double ordered_expectation(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
@@ -234,29 +166,6 @@ void ordered_expectations(const double* lines, const std::uint32_t* orders, cons
     out[k] = ordered_expectation(lines + k * length, orders + k * length, ranks + k * length, length, window, sums,
                                  bound);
 }
-
-void ordered_expectations_of_line(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                                  std::size_t length, const DimensionView* const* windows,
-                                  const WindowSums* const* sums, std::size_t window_count, Bound bound, double* out) {
-  constexpr std::size_t kBatch = 4;
-  for (std::size_t k = 0; k < window_count; ++k)
-    require(windows[k]->first >= 0 && std::size_t(windows[k]->first) + windows[k]->count <= length,
-            "a window inside its line");
-  std::size_t k = 0;
-  auto batches = [&](const RankRuns* runs) {
-    for (; k + kBatch <= window_count; k += kBatch)
-      line_windows_expectations<kBatch>(line, order, rank, length, windows + k, sums + k, bound, runs, out + k);
-  };
-  if (length <= 128 && window_count >= kWindowsForRankRuns) {
-    // Building the runs costs about as much as the masks of a few windows.
-    const RankRuns runs(rank, length);
-    batches(&runs);
-  } else if (length <= 128) {
-    batches(nullptr);
-  }
-  for (; k < window_count; ++k) out[k] = ordered_expectation(line, order, rank, length, *windows[k], *sums[k], bound);
-}
-
 
 void sort_line(const double* values, std::size_t length, Bound bound, std::uint32_t* order, std::uint32_t* rank) {
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;

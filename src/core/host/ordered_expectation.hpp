@@ -2,9 +2,9 @@
 // One O-maximisation of robust_expectation() over a window of a line whose filling order is
 // known: the expectation at the lower bounds, then the budget given in sorted order. The sort is
 // done once per line (sort_line()), and every window applied to the line is a scan: the product
-// sweep applies one window to many lines (ordered_expectations()), the variable elimination many
-// windows to one line (ordered_expectations_of_line()). Results are robust_expectation()'s, bit
-// for bit.
+// sweep applies one window to many lines (ordered_expectations()). Results are
+// robust_expectation()'s, bit for bit. (The variable elimination, many windows to one line, takes
+// the threshold form instead: host/threshold_expectation.hpp.)
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -50,11 +50,5 @@ double ordered_expectation(const double* line, const std::uint32_t* order, const
 void ordered_expectations(const double* lines, const std::uint32_t* orders, const std::uint32_t* ranks,
                           std::size_t length, std::size_t line_count, const DimensionView& window,
                           const WindowSums& sums, Bound bound, double* out);
-
-/// ordered_expectation() of one line with `window_count` windows (windows[k] with sums[k]) into
-/// out[0..window_count): the same results, bit for bit, several windows at a time.
-void ordered_expectations_of_line(const double* line, const std::uint32_t* order, const std::uint32_t* rank,
-                                  std::size_t length, const DimensionView* const* windows,
-                                  const WindowSums* const* sums, std::size_t window_count, Bound bound, double* out);
 
 }  // namespace amytiss::detail

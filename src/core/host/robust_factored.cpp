@@ -62,11 +62,11 @@ void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& 
   // A tuple no row has feeds no row's bound: any feasible window will do.
   const DimensionView nowhere{0, 0, nullptr, {0.0, 1.0}, {0.0, 0.0}};
   std::vector<std::vector<char>> found(dims);
-  windows_.resize(dims);
+  std::vector<std::vector<DimensionView>> windows(dims);
   for (std::size_t d = 0; d < dims; ++d) {
     std::size_t tuples = 1;
     for (std::size_t v : plan_.reads[d]) tuples *= plan_.variables[v].count;
-    windows_[d].assign(tuples, nowhere);
+    windows[d].assign(tuples, nowhere);
     found[d].assign(tuples, 0);
   }
   std::vector<std::size_t> digits;
@@ -81,13 +81,11 @@ void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& 
           for (std::size_t v : plan_.reads[d]) tuple = tuple * plan_.variables[v].count + digits[v];
           if (found[d][tuple]) continue;
           found[d][tuple] = 1;
-          windows_[d][tuple] = rows.distinct(d, rows.bounds_index(row, d));
+          windows[d][tuple] = rows.distinct(d, rows.bounds_index(row, d));
         }
       }
   }
-  sums_.resize(dims);
-  for (std::size_t d = 0; d < dims; ++d)
-    for (const DimensionView& window : windows_[d]) sums_[d].push_back(window_sums(window));
+  for (std::size_t d = 0; d < dims; ++d) packed_.emplace_back(windows[d]);
 }
 
 void RobustFactoredSweep::number_q(const Abstraction& a) {
@@ -153,18 +151,19 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
   require(lines * applied == stage.output_size, "every output entry reads one line");
-  const std::vector<DimensionView>& windows = windows_[dim];
-  const std::vector<WindowSums>& sums = sums_[dim];
-  // Workers take chunks of lines as they go: lines differ in cost (the walks' lengths), and an
+  const PackedWindows& windows = packed_[dim];
+  const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
+  // Workers take chunks of lines as they go: lines differ in cost (the searches' lengths), and an
   // even split would leave a worker idle at the end of the stage. At least 16 lines a chunk: a
   // chunk finds its first line's digits by division, the others by counting.
   const std::size_t chunk = std::clamp<std::size_t>(lines / (16 * std::size_t(threads_)), 16, 256);
   std::atomic<std::size_t> next_line{0};
   parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
-    std::vector<double> line(length), results(applied);
-    std::vector<std::uint32_t> order(length), rank(length);
-    std::vector<const DimensionView*> line_windows(applied);
-    std::vector<const WindowSums*> line_sums(applied);
+    SortedLine line(length);
+    // Where the search of each of the line's windows ended on the previous line (a position):
+    // neighbouring lines hold close values, and their i-th windows are one tuple or neighbouring
+    // ones, so the threshold sits at the same cell or next to it.
+    std::vector<std::uint32_t> ends(applied);
     std::vector<std::size_t> digits;
     for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
       const std::size_t last = std::min(first + chunk, lines);
@@ -180,15 +179,17 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
         tuple_base += digits.back() * digit.tuple_stride;
       }
       for (std::size_t index = first; index < last; ++index) {
-        for (std::size_t a = 0; a < length; ++a) line[a] = in[base + a * stride];
-        sort_line(line.data(), length, bound_, order.data(), rank.data());
+        const bool previous_line = index > first;
+        for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
+        line.sort();
+        // On a chunk's first line, each search starts where the previous window's ended.
+        std::size_t start = length / 2;
         for (std::size_t i = 0; i < applied; ++i) {
-          line_windows[i] = &windows[tuple_base + walk.free_tuples[i]];
-          line_sums[i] = &sums[tuple_base + walk.free_tuples[i]];
+          if (previous_line) start = line.rank(ends[i]);
+          out[output_base + walk.free_offsets[i]] =
+              threshold_expectation(line, windows[tuple_base + walk.free_tuples[i]], bound_, start);
+          ends[i] = std::uint32_t(line.order(start));
         }
-        ordered_expectations_of_line(line.data(), order.data(), rank.data(), length, line_windows.data(),
-                                     line_sums.data(), applied, bound_, results.data());
-        for (std::size_t i = 0; i < applied; ++i) out[output_base + walk.free_offsets[i]] = results[i];
         for (std::size_t j = 0; j < walk.carried.size(); ++j) {
           const StageWalk::Carried& digit = walk.carried[j];
           base += digit.input_stride;

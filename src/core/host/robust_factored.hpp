@@ -6,12 +6,13 @@
 // where the window and its interval masses are post dimension e_k's for the tuple of components
 // e_k reads (the bounds of any row with those components: host/row_bounds.hpp), leave worth 0 and
 // cut worth cut_value(bound), and Q = W_d holds every (cell, input, disturbance)'s bound. Each line
-// of W_{k-1} is read once: sorted, then every tuple applied to it (ordered_expectation()), so the
-// stage keeps no sorted copy of its input.
+// of W_{k-1} is read once: sorted, then every tuple applied to it by the threshold search
+// (threshold_expectation()), each search starting where the same tuple's ended on the line before,
+// so the stage keeps no sorted copy of its input.
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
 // stage may pick its distribution per remaining cell, a superset of the product set), and equal,
-// bit for bit, to product_expectation_in_order() of each row in the same order. It pays where
+// up to rounding, to product_expectation_in_order() of each row in the same order. It pays where
 // coordinates read few components (building automation: 7 dimensions, each reading 2 to 4), where
 // the row-by-row product bound recomputes the same lines for every row.
 #include <cstddef>
@@ -25,6 +26,7 @@
 #include "host/product_sweep.hpp"
 #include "host/row_bounds.hpp"
 #include "host/factored_plan.hpp"
+#include "host/threshold_expectation.hpp"
 
 namespace amytiss::detail {
 
@@ -65,7 +67,7 @@ class RobustFactoredSweep {
   // Stage k from `in` (W_{k-1}, `in_size` entries) into `out` (W_k).
   void run_stage(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Per post dimension, the window of each tuple of the components it reads (tuple digits major
-  // to minor as plan.reads lists them), and its sums.
+  // to minor as plan.reads lists them), packed for the threshold search.
   void gather_windows(const Abstraction& a, const RowBounds& rows, const std::vector<bool>& has_rows);
   // Offsets of a cell, input and disturbance in Q (their variables' digits times plan.q_stride).
   void number_q(const Abstraction& a);
@@ -73,8 +75,7 @@ class RobustFactoredSweep {
   Bound bound_;
   unsigned threads_;
   std::vector<std::size_t> counts_;                  // state cells per dimension
-  std::vector<std::vector<DimensionView>> windows_;  // [dimension][tuple]
-  std::vector<std::vector<WindowSums>> sums_;        // [dimension][tuple]
+  std::vector<PackedWindows> packed_;               // [dimension]: the window of each tuple
   std::vector<StageWalk> walks_;                     // per stage
   std::shared_ptr<SweepBuffers> buffers_;            // the ping-pong W_k
   std::vector<double> q_;

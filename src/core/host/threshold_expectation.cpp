@@ -1,0 +1,234 @@
+#include "host/threshold_expectation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "host/ordered_expectation.hpp"
+
+// The pass is the hot loop of the variable elimination: built for AVX-512 and AVX2 as well as the
+// baseline, the best one picked when the library loads.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define AMYTISS_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define AMYTISS_VECTOR_CLONES
+#endif
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace amytiss::detail {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+typedef double Lanes __attribute__((vector_size(kThresholdLanes * sizeof(double))));
+typedef long LaneMask __attribute__((vector_size(kThresholdLanes * sizeof(double))));
+
+// mask ? a : b lane by lane, in bit operations: GCC turns a vector ?: into scalar code. Always
+// inlined into the clones, so the baseline's ABI for vector arguments never applies (the -Wpsabi
+// note, which GCC gives at the end of the file, is switched off above).
+__attribute__((always_inline)) inline Lanes select(LaneMask mask, Lanes a, Lanes b) {
+  return reinterpret_cast<Lanes>((mask & reinterpret_cast<LaneMask>(a)) | (~mask & reinterpret_cast<LaneMask>(b)));
+}
+
+// D at threshold t over a window: D(t) - t, and the weights of its slope on either side of t.
+struct PassSums {
+  double below = 0.0;  // sum of (key < t ? hi : lo): 1 - D's slope just below t
+  double above = 0.0;  // sum of (key > t ? lo : hi): 1 - D's slope just above t; D's weights
+  double dual = 0.0;   // sum of (key - t) * (key > t ? lo : hi)
+};
+
+AMYTISS_VECTOR_CLONES
+PassSums cells_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count, double t) {
+  const Lanes threshold = Lanes{} + t;
+  Lanes below{}, above{}, dual{};
+  for (std::size_t j = 0; j < padded_count; j += kThresholdLanes) {
+    Lanes key, low, high;
+    std::memcpy(&key, keys + j, sizeof key);
+    std::memcpy(&low, lo + j, sizeof low);
+    std::memcpy(&high, hi + j, sizeof high);
+    below += select(key < threshold, high, low);
+    const Lanes weight = select(key > threshold, low, high);
+    above += weight;
+    dual += weight * (key - threshold);
+  }
+  PassSums sums;
+  for (std::size_t lane = 0; lane < kThresholdLanes; ++lane) {
+    sums.below += below[lane];
+    sums.above += above[lane];
+    sums.dual += dual[lane];
+  }
+  return sums;
+}
+
+// Leave or cut, one outcome as the pass takes a cell.
+void add_outcome(PassSums& sums, double key, const MassInterval& mass, double t) {
+  sums.below += key < t ? mass.hi : mass.lo;
+  const double weight = key > t ? mass.lo : mass.hi;
+  sums.above += weight;
+  sums.dual += weight * (key - t);
+}
+
+// The outcomes of one key next to t with slack: the window's cells of that key and leave or cut.
+struct Group {
+  double key;
+  double slack = 0.0;
+  std::size_t rank;  // the last of the group's cells met in the line's order (the start if none)
+};
+
+// Calls visit(rank) for the window's ranks from `from` on in `direction` (+1: from and up; -1:
+// below from, down) until it returns false.
+template <typename Visit>
+void window_ranks(const SortedLine& line, const PackedWindow& window, std::size_t from, int direction,
+                  Visit&& visit) {
+  if (line.length() > SortedLine::kMaskedLength) {
+    for (std::size_t q = direction > 0 ? from : from - 1; q < line.length(); q += direction)  // wraps below 0
+      if (line.order(q) - window.first < window.count && !visit(q)) return;
+    return;
+  }
+  std::uint64_t mask[2];
+  line.ranks_of(window.first, window.count, mask);
+  if (direction > 0) {
+    for (std::size_t word = from / 64; word < 2; ++word) {
+      std::uint64_t bits = mask[word] & (word == from / 64 ? ~std::uint64_t(0) << (from % 64) : ~std::uint64_t(0));
+      for (; bits; bits &= bits - 1)
+        if (!visit(word * 64 + std::size_t(__builtin_ctzll(bits)))) return;
+    }
+  } else {
+    for (std::size_t word = std::min<std::size_t>(from / 64, 1) + 1; word-- > 0;) {
+      std::uint64_t bits = mask[word];
+      if (word == from / 64) bits &= (std::uint64_t(1) << (from % 64)) - 1;
+      for (; bits; bits &= ~(std::uint64_t(1) << (63 - __builtin_clzll(bits))))
+        if (!visit(word * 64 + std::size_t(63 - __builtin_clzll(bits)))) return;
+    }
+  }
+}
+
+// The window's next key past t in `direction` (+1 up, -1 down) among its outcomes with slack,
+// from rank `start` (whose key is t, or, after leave or cut, lies before t); key +-infinity
+// where there is none.
+Group next_group(const SortedLine& line, const PackedWindow& window, const double* extra_keys, double t,
+                 std::size_t start, int direction) {
+  Group group{direction * kInfinity, 0.0, start};
+  auto beyond = [&](double a, double b) { return direction > 0 ? a > b : a < b; };
+  const bool at_t = line.keys()[line.order(start)] == t;
+  const std::size_t from = direction > 0 ? (at_t ? line.run_last(start) : start) + 1
+                                         : (at_t ? line.run_first(start) : start);
+  window_ranks(line, window, from, direction, [&](std::size_t q) {
+    const double key = line.keys()[line.order(q)];
+    if (beyond(key, group.key)) return false;
+    const std::size_t j = line.order(q) - window.first;
+    const double slack = window.hi[j] - window.lo[j];
+    if (slack > 0.0 && beyond(key, t)) {
+      group.key = key;
+      group.slack += slack;
+      group.rank = q;
+    }
+    return true;
+  });
+  const MassInterval extras[2] = {window.leave, window.cut};
+  for (std::size_t e = 0; e < 2; ++e) {
+    if (!(extras[e].hi > extras[e].lo) || !beyond(extra_keys[e], t) || beyond(extra_keys[e], group.key)) continue;
+    if (extra_keys[e] != group.key) group.slack = 0.0;
+    group.key = extra_keys[e];
+    group.slack += extras[e].hi - extras[e].lo;
+  }
+  return group;
+}
+
+}  // namespace
+
+PackedWindows::PackedWindows(const std::vector<DimensionView>& windows) {
+  std::size_t total = 0;
+  for (const DimensionView& window : windows) {
+    window_sums(window);  // a feasible row, or std::logic_error
+    PackedWindow sized;
+    sized.count = window.count;
+    total += sized.padded_count();
+  }
+  lo_.assign(total, 0.0);
+  hi_.assign(total, 0.0);
+  std::size_t offset = 0;
+  for (const DimensionView& window : windows) {
+    PackedWindow packed{std::size_t(window.first), window.count, lo_.data() + offset, hi_.data() + offset,
+                        window.leave, window.cut};
+    for (std::size_t j = 0; j < window.count; ++j) {
+      lo_[offset + j] = window.cells[j].lo;
+      hi_[offset + j] = window.cells[j].hi;
+    }
+    offset += packed.padded_count();
+    views_.push_back(packed);
+  }
+}
+
+SortedLine::SortedLine(std::size_t length)
+    : length_(length),
+      keys_(length + kThresholdLanes, 0.0),
+      order_(length),
+      rank_(length),
+      run_first_(length),
+      run_last_(length) {
+  if (length <= kMaskedLength) rank_bits_.assign((length + 1) * 2, 0);
+}
+
+void SortedLine::sort() {
+  sort_line(keys_.data(), length_, Bound::Lower, order_.data(), rank_.data());
+  for (std::size_t r = 0; r < length_; ++r)
+    run_first_[r] = r > 0 && keys_[order_[r]] == keys_[order_[r - 1]] ? run_first_[r - 1] : std::uint32_t(r);
+  for (std::size_t r = length_; r-- > 0;)
+    run_last_[r] = r + 1 < length_ && keys_[order_[r]] == keys_[order_[r + 1]] ? run_last_[r + 1] : std::uint32_t(r);
+  if (rank_bits_.empty()) return;
+  // Ranks are distinct: the bits of positions first .. last - 1 are prefix(last) minus prefix(first).
+  for (std::size_t position = 0; position < length_; ++position) {
+    const std::size_t r = rank_[position];
+    rank_bits_[(position + 1) * 2] = rank_bits_[position * 2] | (r < 64 ? std::uint64_t(1) << r : 0);
+    rank_bits_[(position + 1) * 2 + 1] = rank_bits_[position * 2 + 1] | (r < 64 ? 0 : std::uint64_t(1) << (r - 64));
+  }
+}
+
+void SortedLine::ranks_of(std::size_t first, std::size_t count, std::uint64_t* mask) const {
+  for (std::size_t word = 0; word < 2; ++word)
+    mask[word] = rank_bits_[(first + count) * 2 + word] & ~rank_bits_[first * 2 + word];
+}
+
+double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start) {
+  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
+  const double extra_keys[2] = {0.0, sign * cut_value(bound)};  // leave, cut
+  const std::size_t outcomes = window.count + 2;
+  // D(t) less its error bound: at most `outcomes` + 2 roundings of terms whose magnitudes sum to
+  // at most |t| + above * (1 + |t|), keys lying in [-1, 1].
+  PassSums sums;
+  auto sound_dual = [&](double t) {
+    sums = cells_pass(line.keys() + window.first, window.lo, window.hi, window.padded_count(), t);
+    add_outcome(sums, extra_keys[0], window.leave, t);
+    add_outcome(sums, extra_keys[1], window.cut, t);
+    const double error = robust_expectation_rounding(outcomes) * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));
+    return t + sums.dual - error;
+  };
+  double t = line.keys()[line.order(start)];
+  double best = sound_dual(t);
+  // D is linear between neighbouring keys with slack: with slope 1 - above above t, 1 - below
+  // below it. Each step moves to the next such key, where D's slope is updated by the key's slack,
+  // while D still rises. A step's own rounding: that of the sums behind the slope and of three
+  // operations, within the bound for `outcomes` + 2 terms. After more than kStepsInOnePass steps
+  // their roundings would add up: D is evaluated afresh where the search ends.
+  constexpr std::size_t kStepsInOnePass = 2;
+  const double step_rounding = robust_expectation_rounding(outcomes + 2);
+  const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
+  double slope_weight = direction > 0 ? sums.above : sums.below, dual = best;
+  std::size_t steps = 0;
+  for (; direction != 0 && steps < outcomes; ++steps) {
+    const Group next = next_group(line, window, extra_keys, t, start, direction);
+    if (std::abs(next.key) == kInfinity) break;
+    dual += (next.key - t) * (1.0 - slope_weight) - step_rounding * (1.0 + slope_weight);
+    best = std::max(best, dual);
+    t = next.key;
+    start = next.rank;
+    slope_weight += direction * next.slack;
+    if (direction > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
+  }
+  if (steps > kStepsInOnePass) best = std::max(best, sound_dual(t));
+  return std::clamp(sign * best, 0.0, 1.0);
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,83 @@
+#pragma once
+// The O-maximisation by its threshold, for many windows over one line (the variable elimination).
+// With keys k_j = value_j (lower bound) or -value_j (upper), the minimum of sum_j p_j k_j over
+// lo <= p <= hi, sum_j p_j = 1 equals, by linear-programming duality,
+//   max over t of  D(t) = t + sum_j (k_j - t) * (k_j > t ? lo_j : hi_j),
+// and D(t) is at most that minimum for every t. The maximiser is the key at which
+// robust_expectation()'s filling runs out of budget. A search from a guess (where the search of
+// a neighbouring window ended) evaluates D there in one vectorised pass over the window, then
+// steps from key to key of the window in the line's sorted order, D and its slope updated as it
+// goes, until the slope changes sign; whichever threshold it ends on, the bound is sound. The
+// result equals robust_expectation()'s up to rounding, each moved outward by its own error bound.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "host/interval_bellman.hpp"
+
+namespace amytiss::detail {
+
+/// Cells per pass of the search; windows are padded with zero intervals to a multiple of it.
+constexpr std::size_t kThresholdLanes = 4;
+
+/// A window as the search reads it: cells first .. first + count - 1 of the line, their lower and
+/// upper bounds in two arrays of padded_count() entries (zeros past count), then leave and cut.
+struct PackedWindow {
+  std::size_t first = 0, count = 0;
+  const double* lo = nullptr;
+  const double* hi = nullptr;
+  MassInterval leave, cut;
+  std::size_t padded_count() const { return (count + kThresholdLanes - 1) / kThresholdLanes * kThresholdLanes; }
+};
+
+/// The windows of one dimension, packed (views into storage the object owns; not copyable).
+class PackedWindows {
+ public:
+  explicit PackedWindows(const std::vector<DimensionView>& windows);
+  PackedWindows(const PackedWindows&) = delete;
+  PackedWindows& operator=(const PackedWindows&) = delete;
+  PackedWindows(PackedWindows&&) = default;
+  const PackedWindow& operator[](std::size_t k) const { return views_[k]; }
+
+ private:
+  std::vector<double> lo_, hi_;
+  std::vector<PackedWindow> views_;
+};
+
+/// One line of keys (value for Bound::Lower, -value for Bound::Upper; values in [0, 1]) as the
+/// search reads it: the keys, padded with kThresholdLanes zeros; their increasing order (stable);
+/// each rank's run of equal keys; and, for lines up to kMaskedLength long, the ranks of the
+/// positions before each position as bits, so that a window's ranks are two lookups.
+class SortedLine {
+ public:
+  static constexpr std::size_t kMaskedLength = 128;
+  explicit SortedLine(std::size_t length);
+  std::size_t length() const { return length_; }
+  /// The keys: write keys()[0..length()) before sort().
+  double* keys() { return keys_.data(); }
+  const double* keys() const { return keys_.data(); }
+  /// Sorts the keys and builds the tables.
+  void sort();
+  /// The position of rank r, the rank of a position.
+  std::size_t order(std::size_t r) const { return order_[r]; }
+  std::size_t rank(std::size_t position) const { return rank_[position]; }
+  /// The first and last rank of r's run of equal keys.
+  std::size_t run_first(std::size_t r) const { return run_first_[r]; }
+  std::size_t run_last(std::size_t r) const { return run_last_[r]; }
+  /// Lines up to kMaskedLength long: the ranks of positions first .. first + count - 1 as bits of
+  /// two words.
+  void ranks_of(std::size_t first, std::size_t count, std::uint64_t* mask) const;
+
+ private:
+  std::size_t length_;
+  std::vector<double> keys_;
+  std::vector<std::uint32_t> order_, rank_, run_first_, run_last_;
+  std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
+};
+
+/// The bound of one window over a sorted line: robust_expectation()'s up to rounding, moved
+/// outward by its error bound and clipped to [0, 1]. `start`: the rank whose key the search starts
+/// from on entry, where it ended on return (a good start for an overlapping window).
+double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start);
+
+}  // namespace amytiss::detail

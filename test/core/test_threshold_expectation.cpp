@@ -1,0 +1,95 @@
+// The O-maximisation by its threshold (host/threshold_expectation.hpp): a sorted line's tables are
+// those of the stable sort, its runs of equal keys and its windows' ranks; from any starting rank,
+// on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
+// without slack, and leave or cut taking the whole budget, the search gives robust_expectation()'s
+// bound within rounding, never past the exact value's sound side, and ends on a rank of the line.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "host/ordered_expectation.hpp"
+#include "host/threshold_expectation.hpp"
+#include "random_rows.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+using namespace amytiss::test_rows;
+
+constexpr unsigned kSeed = 20261202;
+constexpr int kTrials = 300;
+// Both bounds are robust_expectation()'s exact value moved outward by at most a few 1e-14.
+constexpr double kAgreement = 1e-12;
+
+const std::size_t kLengths[] = {1, 2, 5, 41, 64, 65, 128, 129, 200, 300};
+
+SortedLine sorted_line(const std::vector<double>& values, Bound bound) {
+  SortedLine line(values.size());
+  for (std::size_t a = 0; a < values.size(); ++a) line.keys()[a] = (bound == Bound::Lower ? 1.0 : -1.0) * values[a];
+  line.sort();
+  return line;
+}
+
+TEST(ThresholdExpectation, SortedLineHoldsTheStableOrderItsRunsAndEachWindowsRanks) {
+  std::mt19937 random(kSeed);
+  for (std::size_t length : kLengths)
+    for (int trial = 0; trial < kTrials / 10; ++trial) {
+      const std::vector<double> values = random_line(random, length);
+      const SortedLine line = sorted_line(values, Bound::Upper);
+      std::vector<std::uint32_t> order(length), rank(length);
+      sort_line(values.data(), length, Bound::Upper, order.data(), rank.data());
+      for (std::size_t r = 0; r < length; ++r) {
+        ASSERT_EQ(line.order(r), order[r]);
+        ASSERT_EQ(line.rank(order[r]), r);
+        const double key = line.keys()[line.order(r)];
+        ASSERT_EQ(line.keys()[line.order(line.run_first(r))], key);
+        ASSERT_EQ(line.keys()[line.order(line.run_last(r))], key);
+        ASSERT_TRUE(line.run_first(r) == 0 || line.keys()[line.order(line.run_first(r) - 1)] < key);
+        ASSERT_TRUE(line.run_last(r) + 1 == length || line.keys()[line.order(line.run_last(r) + 1)] > key);
+      }
+      if (length > SortedLine::kMaskedLength) continue;
+      for (std::size_t first = 0; first < length; ++first)
+        for (std::size_t count = 0; first + count <= length; count += 7) {
+          std::uint64_t mask[2], expected[2] = {0, 0};
+          line.ranks_of(first, count, mask);
+          for (std::size_t position = first; position < first + count; ++position)
+            expected[rank[position] / 64] |= std::uint64_t(1) << (rank[position] % 64);
+          ASSERT_EQ(mask[0], expected[0]) << "length " << length << " first " << first << " count " << count;
+          ASSERT_EQ(mask[1], expected[1]) << "length " << length << " first " << first << " count " << count;
+        }
+    }
+}
+
+TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundSide) {
+  std::mt19937 random(kSeed);
+  for (std::size_t length : kLengths)
+    for (int trial = 0; trial < kTrials; ++trial) {
+      // Values on a few levels (long runs of ties) or drawn from [0, 1].
+      const std::vector<double> values = trial % 2 ? random_line(random, length) : random_smooth_line(random, length);
+      RandomRow row = random_row(random, length);
+      row.window.cells = row.cells.data();
+      const PackedWindows packed(std::vector<DimensionView>{row.window});
+      const double rounding = robust_expectation_rounding(row.cells.size() + 2);
+      for (Bound bound : {Bound::Lower, Bound::Upper}) {
+        const SortedLine line = sorted_line(values, bound);
+        const double sorted = sorted_expectation(values, row, bound);
+        std::uniform_int_distribution<std::size_t> any_rank(0, length - 1);
+        for (std::size_t start : {std::size_t(0), length / 2, length - 1, any_rank(random)}) {
+          std::size_t end = start;
+          const double bound_value = threshold_expectation(line, packed[0], bound, end);
+          ASSERT_LT(end, length);
+          EXPECT_NEAR(bound_value, sorted, kAgreement)
+              << "length " << length << " trial " << trial << " start " << start;
+          // The sorted bound lies within twice its rounding of the exact value; ours lies on its
+          // sound side of it.
+          if (bound == Bound::Lower)
+            EXPECT_LE(bound_value, sorted + 2 * rounding) << "length " << length << " trial " << trial;
+          else
+            EXPECT_GE(bound_value, sorted - 2 * rounding) << "length " << length << " trial " << trial;
+        }
+      }
+    }
+}
+
+}  // namespace
+}  // namespace amytiss::detail
