@@ -1,5 +1,6 @@
 // The product bound by variable elimination (host/robust_factored.hpp): every (cell, input,
-// disturbance) gets product_expectation_in_order() of its row in the plan's order, within rounding;
+// disturbance) gets product_expectation_in_order() of its row in the plan's order, within rounding,
+// and the same bits on any number of workers;
 // that oracle is product_expectation() in the order (d-1, ..., 0) and lies within the joint
 // interval MDP's bounds in every order; the step takes this way where the sweep over whole tables
 // does not pay, and its bounds then stay sound against the joint reference.
@@ -119,6 +120,27 @@ TEST(RobustFactored, SweepGivesEveryRowItsBoundInThePlansOrder) {
                 << "cell " << cell << " input " << input << " disturbance " << w;
           }
     }
+  }
+}
+
+TEST(RobustFactored, SweepGivesTheSameBitsOnAnyNumberOfWorkers) {
+  const Abstraction a = from_yaml(sparse_3d_yaml());
+  const ImageEnclosure enclosure(a.config);
+  const RowBounds rows = all_rows(a, enclosure);
+  std::string reason;
+  const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, &reason);
+  ASSERT_TRUE(plan) << reason;
+  const std::vector<double> values = test_values(a.states.size()).front();
+  for (Bound bound : {Bound::Lower, Bound::Upper}) {
+    RobustFactoredSweep one(a, rows, std::vector<bool>(a.states.size(), true), *plan, bound, 1);
+    RobustFactoredSweep three(a, rows, std::vector<bool>(a.states.size(), true), *plan, bound, 3);
+    one.prepare(values.data());
+    three.prepare(values.data());
+    for (std::size_t cell = 0; cell < a.states.size(); ++cell)
+      for (std::size_t input = 0; input < a.inputs.size(); ++input)
+        for (std::size_t w = 0; w < a.disturbances.size(); ++w)
+          ASSERT_EQ(one.expectation(cell, input, w), three.expectation(cell, input, w))
+              << "cell " << cell << " input " << input << " disturbance " << w;
   }
 }
 

@@ -1,10 +1,12 @@
-// The O-maximisation by its threshold (host/threshold_expectation.hpp): a sorted line's tables are
-// those of the stable sort, its runs of equal keys and its windows' ranks; from any starting rank,
+// The O-maximisation by its threshold (host/threshold_expectation.hpp): a sorted line holds an
+// increasing order (line after line, neighbours and lines drawn afresh), its runs of equal keys
+// and its windows' ranks; from any starting rank,
 // on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
 // without slack, and leave or cut taking the whole budget, the search gives robust_expectation()'s
 // bound within rounding, never past the exact value's sound side, and ends on a rank of the line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "host/ordered_expectation.hpp"
@@ -26,22 +28,32 @@ const std::size_t kLengths[] = {1, 2, 5, 41, 64, 65, 128, 129, 200, 300};
 SortedLine sorted_line(const std::vector<double>& values, Bound bound) {
   SortedLine line(values.size());
   for (std::size_t a = 0; a < values.size(); ++a) line.keys()[a] = (bound == Bound::Lower ? 1.0 : -1.0) * values[a];
-  line.sort();
+  line.sort(false);
   return line;
 }
 
-TEST(ThresholdExpectation, SortedLineHoldsTheStableOrderItsRunsAndEachWindowsRanks) {
+// Sorted lines in a row: each a neighbour of the last (a few values moved a little), now and then
+// one drawn afresh.
+TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderItsRunsAndEachWindowsRanks) {
   std::mt19937 random(kSeed);
-  for (std::size_t length : kLengths)
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::size_t length : kLengths) {
+    SortedLine line(length);
+    std::vector<double> values = random_smooth_line(random, length);
     for (int trial = 0; trial < kTrials / 10; ++trial) {
-      const std::vector<double> values = random_line(random, length);
-      const SortedLine line = sorted_line(values, Bound::Upper);
-      std::vector<std::uint32_t> order(length), rank(length);
-      sort_line(values.data(), length, Bound::Upper, order.data(), rank.data());
+      if (trial % 7 == 0) values = trial % 2 ? random_line(random, length) : random_smooth_line(random, length);
+      for (double& value : values)
+        if (unit(random) < 0.1) value = std::clamp(value + 0.05 * (unit(random) - 0.5), 0.0, 1.0);
+      for (std::size_t a = 0; a < length; ++a) line.keys()[a] = -values[a];
+      line.sort(trial % 3 != 0);
+      std::vector<char> seen(length, 0);
       for (std::size_t r = 0; r < length; ++r) {
-        ASSERT_EQ(line.order(r), order[r]);
-        ASSERT_EQ(line.rank(order[r]), r);
+        ASSERT_LT(line.order(r), length);
+        ASSERT_FALSE(seen[line.order(r)]) << "order is a permutation";
+        seen[line.order(r)] = 1;
+        ASSERT_EQ(line.rank(line.order(r)), r);
         const double key = line.keys()[line.order(r)];
+        ASSERT_TRUE(r == 0 || line.keys()[line.order(r - 1)] <= key) << "length " << length << " trial " << trial;
         ASSERT_EQ(line.keys()[line.order(line.run_first(r))], key);
         ASSERT_EQ(line.keys()[line.order(line.run_last(r))], key);
         ASSERT_TRUE(line.run_first(r) == 0 || line.keys()[line.order(line.run_first(r) - 1)] < key);
@@ -53,11 +65,12 @@ TEST(ThresholdExpectation, SortedLineHoldsTheStableOrderItsRunsAndEachWindowsRan
           std::uint64_t mask[2], expected[2] = {0, 0};
           line.ranks_of(first, count, mask);
           for (std::size_t position = first; position < first + count; ++position)
-            expected[rank[position] / 64] |= std::uint64_t(1) << (rank[position] % 64);
+            expected[line.rank(position) / 64] |= std::uint64_t(1) << (line.rank(position) % 64);
           ASSERT_EQ(mask[0], expected[0]) << "length " << length << " first " << first << " count " << count;
           ASSERT_EQ(mask[1], expected[1]) << "length " << length << " first " << first << " count " << count;
         }
     }
+  }
 }
 
 TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundSide) {

@@ -155,8 +155,10 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
   const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
   // Workers take chunks of lines as they go: lines differ in cost (the searches' lengths), and an
   // even split would leave a worker idle at the end of the stage. At least 16 lines a chunk: a
-  // chunk finds its first line's digits by division, the others by counting.
-  const std::size_t chunk = std::clamp<std::size_t>(lines / (16 * std::size_t(threads_)), 16, 256);
+  // chunk finds its first line's digits by division, the others by counting. The chunks do not
+  // depend on the number of workers, nor, therefore, do the results, bit for bit (a chunk's
+  // searches start from its own lines).
+  const std::size_t chunk = std::clamp<std::size_t>(lines / 64, 16, 256);
   std::atomic<std::size_t> next_line{0};
   parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
     SortedLine line(length);
@@ -181,7 +183,7 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
       for (std::size_t index = first; index < last; ++index) {
         const bool previous_line = index > first;
         for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
-        line.sort();
+        line.sort(previous_line);  // a chunk's lines alone decide its results, bit for bit
         // On a chunk's first line, each search starts where the previous window's ended.
         std::size_t start = length / 2;
         for (std::size_t i = 0; i < applied; ++i) {

@@ -171,8 +171,28 @@ SortedLine::SortedLine(std::size_t length)
   if (length <= kMaskedLength) rank_bits_.assign((length + 1) * 2, 0);
 }
 
-void SortedLine::sort() {
-  sort_line(keys_.data(), length_, Bound::Lower, order_.data(), rank_.data());
+void SortedLine::sort(bool from_last) {
+  // Neighbouring lines hold close values, so the last line's order is nearly this one's: insertion
+  // from it costs a comparison per key and a move per pair out of order. A line far from the last
+  // (more than kMovesPerKey moves per key) is sorted afresh.
+  constexpr std::size_t kMovesPerKey = 2;
+  bool sorted = false;
+  if (from_last && sorted_before_) {
+    sorted = true;
+    for (std::size_t i = 1, moves = 0; i < length_ && sorted; ++i) {
+      const std::uint32_t position = order_[i];
+      std::size_t j = i;
+      for (; j > 0 && keys_[order_[j - 1]] > keys_[position]; --j) order_[j] = order_[j - 1];
+      order_[j] = position;
+      moves += i - j;
+      sorted = moves <= kMovesPerKey * length_;
+    }
+  }
+  if (sorted)
+    for (std::size_t r = 0; r < length_; ++r) rank_[order_[r]] = std::uint32_t(r);
+  else
+    sort_line(keys_.data(), length_, Bound::Lower, order_.data(), rank_.data());
+  sorted_before_ = true;
   for (std::size_t r = 0; r < length_; ++r)
     run_first_[r] = r > 0 && keys_[order_[r]] == keys_[order_[r - 1]] ? run_first_[r - 1] : std::uint32_t(r);
   for (std::size_t r = length_; r-- > 0;)

@@ -45,7 +45,7 @@ class PackedWindows {
 };
 
 /// One line of keys (value for Bound::Lower, -value for Bound::Upper; values in [0, 1]) as the
-/// search reads it: the keys, padded with kThresholdLanes zeros; their increasing order (stable);
+/// search reads it: the keys, padded with kThresholdLanes zeros; their increasing order;
 /// each rank's run of equal keys; and, for lines up to kMaskedLength long, the ranks of the
 /// positions before each position as bits, so that a window's ranks are two lookups.
 class SortedLine {
@@ -56,8 +56,9 @@ class SortedLine {
   /// The keys: write keys()[0..length()) before sort().
   double* keys() { return keys_.data(); }
   const double* keys() const { return keys_.data(); }
-  /// Sorts the keys and builds the tables.
-  void sort();
+  /// Sorts the keys and builds the tables: from the order of the line sorted before (a
+  /// neighbour: faster; ties then keep that order), or afresh (ties in position order).
+  void sort(bool from_last);
   /// The position of rank r, the rank of a position.
   std::size_t order(std::size_t r) const { return order_[r]; }
   std::size_t rank(std::size_t position) const { return rank_[position]; }
@@ -70,6 +71,7 @@ class SortedLine {
 
  private:
   std::size_t length_;
+  bool sorted_before_ = false;
   std::vector<double> keys_;
   std::vector<std::uint32_t> order_, rank_, run_first_, run_last_;
   std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
