@@ -3,7 +3,8 @@
 // and its windows' ranks; from any starting rank,
 // on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
 // without slack, and leave or cut taking the whole budget, the search gives robust_expectation()'s
-// bound within rounding, never past the exact value's sound side, and ends on a rank of the line.
+// bound within rounding, never past the exact value's sound side, and ends on a rank of the line,
+// with each vector unit the processor has (AVX2 and the baseline giving the same search).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,31 +75,56 @@ TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderItsRunsAndEachWindows
 }
 
 TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundSide) {
+  for (VectorUnit unit : vector_units()) {
+    std::mt19937 random(kSeed);
+    for (std::size_t length : kLengths)
+      for (int trial = 0; trial < kTrials; ++trial) {
+        // Values on a few levels (long runs of ties) or drawn from [0, 1].
+        const std::vector<double> values = trial % 2 ? random_line(random, length) : random_smooth_line(random, length);
+        RandomRow row = random_row(random, length);
+        row.window.cells = row.cells.data();
+        const PackedWindows packed(std::vector<DimensionView>{row.window});
+        const double rounding = robust_expectation_rounding(row.cells.size() + 2);
+        for (Bound bound : {Bound::Lower, Bound::Upper}) {
+          const SortedLine line = sorted_line(values, bound);
+          const double sorted = sorted_expectation(values, row, bound);
+          std::uniform_int_distribution<std::size_t> any_rank(0, length - 1);
+          for (std::size_t start : {std::size_t(0), length / 2, length - 1, any_rank(random)}) {
+            std::size_t end = start;
+            const double bound_value = threshold_expectation(line, packed[0], bound, end, unit);
+            ASSERT_LT(end, length);
+            EXPECT_NEAR(bound_value, sorted, kAgreement)
+                << "length " << length << " trial " << trial << " start " << start;
+            // The sorted bound lies within twice its rounding of the exact value; ours lies on its
+            // sound side of it.
+            if (bound == Bound::Lower)
+              EXPECT_LE(bound_value, sorted + 2 * rounding) << "length " << length << " trial " << trial;
+            else
+              EXPECT_GE(bound_value, sorted - 2 * rounding) << "length " << length << " trial " << trial;
+          }
+        }
+      }
+  }
+}
+
+TEST(ThresholdExpectation, EveryVectorUnitGivesTheBaselinesBoundUpToTheOrderOfAdditions) {
   std::mt19937 random(kSeed);
+  const std::vector<VectorUnit> units = vector_units();
+  if (units.size() == 1) GTEST_SKIP() << "this processor has the baseline vector unit only";
   for (std::size_t length : kLengths)
     for (int trial = 0; trial < kTrials; ++trial) {
-      // Values on a few levels (long runs of ties) or drawn from [0, 1].
-      const std::vector<double> values = trial % 2 ? random_line(random, length) : random_smooth_line(random, length);
+      const std::vector<double> values = random_smooth_line(random, length);
       RandomRow row = random_row(random, length);
       row.window.cells = row.cells.data();
       const PackedWindows packed(std::vector<DimensionView>{row.window});
-      const double rounding = robust_expectation_rounding(row.cells.size() + 2);
       for (Bound bound : {Bound::Lower, Bound::Upper}) {
         const SortedLine line = sorted_line(values, bound);
-        const double sorted = sorted_expectation(values, row, bound);
-        std::uniform_int_distribution<std::size_t> any_rank(0, length - 1);
-        for (std::size_t start : {std::size_t(0), length / 2, length - 1, any_rank(random)}) {
-          std::size_t end = start;
-          const double bound_value = threshold_expectation(line, packed[0], bound, end);
-          ASSERT_LT(end, length);
-          EXPECT_NEAR(bound_value, sorted, kAgreement)
-              << "length " << length << " trial " << trial << " start " << start;
-          // The sorted bound lies within twice its rounding of the exact value; ours lies on its
-          // sound side of it.
-          if (bound == Bound::Lower)
-            EXPECT_LE(bound_value, sorted + 2 * rounding) << "length " << length << " trial " << trial;
-          else
-            EXPECT_GE(bound_value, sorted - 2 * rounding) << "length " << length << " trial " << trial;
+        std::size_t baseline_end = length / 2;
+        const double baseline = threshold_expectation(line, packed[0], bound, baseline_end, VectorUnit::Baseline);
+        for (VectorUnit unit : units) {
+          std::size_t end = length / 2;
+          EXPECT_NEAR(threshold_expectation(line, packed[0], bound, end, unit), baseline, kAgreement);
+          EXPECT_EQ(end, baseline_end) << "length " << length << " trial " << trial;
         }
       }
     }

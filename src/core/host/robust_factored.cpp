@@ -189,7 +189,7 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
         for (std::size_t i = 0; i < applied; ++i) {
           if (previous_line) start = line.rank(ends[i]);
           out[output_base + walk.free_offsets[i]] =
-              threshold_expectation(line, windows[tuple_base + walk.free_tuples[i]], bound_, start);
+              threshold_expectation(line, windows[tuple_base + walk.free_tuples[i]], bound_, start, unit_);
           ends[i] = std::uint32_t(line.order(start));
         }
         for (std::size_t j = 0; j < walk.carried.size(); ++j) {

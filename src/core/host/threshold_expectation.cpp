@@ -7,12 +7,10 @@
 
 #include "host/ordered_expectation.hpp"
 
-// The pass is the hot loop of the variable elimination: built for AVX-512 and AVX2 as well as the
-// baseline, the best one picked when the library loads.
+// The pass is the hot loop of the variable elimination: built for AVX2 with FMA as well as for the
+// baseline instruction set.
 #if defined(__x86_64__) && defined(__GNUC__)
-#define AMYTISS_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define AMYTISS_VECTOR_CLONES
+#define AMYTISS_HAS_AVX2_PASS 1
 #endif
 #pragma GCC diagnostic ignored "-Wpsabi"
 
@@ -25,7 +23,7 @@ typedef double Lanes __attribute__((vector_size(kThresholdLanes * sizeof(double)
 typedef long LaneMask __attribute__((vector_size(kThresholdLanes * sizeof(double))));
 
 // mask ? a : b lane by lane, in bit operations: GCC turns a vector ?: into scalar code. Always
-// inlined into the clones, so the baseline's ABI for vector arguments never applies (the -Wpsabi
+// inlined into the passes, so the baseline's ABI for vector arguments never applies (the -Wpsabi
 // note, which GCC gives at the end of the file, is switched off above).
 __attribute__((always_inline)) inline Lanes select(LaneMask mask, Lanes a, Lanes b) {
   return reinterpret_cast<Lanes>((mask & reinterpret_cast<LaneMask>(a)) | (~mask & reinterpret_cast<LaneMask>(b)));
@@ -38,8 +36,9 @@ struct PassSums {
   double dual = 0.0;   // sum of (key - t) * (key > t ? lo : hi)
 };
 
-AMYTISS_VECTOR_CLONES
-PassSums cells_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count, double t) {
+// The pass's body, inlined into one function per instruction set.
+__attribute__((always_inline)) inline PassSums pass_body(const double* keys, const double* lo, const double* hi,
+                                                         std::size_t padded_count, double t) {
   const Lanes threshold = Lanes{} + t;
   Lanes below{}, above{}, dual{};
   for (std::size_t j = 0; j < padded_count; j += kThresholdLanes) {
@@ -59,6 +58,25 @@ PassSums cells_pass(const double* keys, const double* lo, const double* hi, std:
     sums.dual += dual[lane];
   }
   return sums;
+}
+
+PassSums baseline_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count, double t) {
+  return pass_body(keys, lo, hi, padded_count, t);
+}
+
+#ifdef AMYTISS_HAS_AVX2_PASS
+__attribute__((target("avx2,fma"))) PassSums avx2_pass(const double* keys, const double* lo, const double* hi,
+                                                       std::size_t padded_count, double t) {
+  return pass_body(keys, lo, hi, padded_count, t);
+}
+#endif
+
+PassSums cells_pass(VectorUnit unit, const double* keys, const double* lo, const double* hi, std::size_t padded_count,
+                    double t) {
+#ifdef AMYTISS_HAS_AVX2_PASS
+  if (unit == VectorUnit::Avx2) return avx2_pass(keys, lo, hi, padded_count, t);
+#endif
+  return baseline_pass(keys, lo, hi, padded_count, t);
 }
 
 // Leave or cut, one outcome as the pass takes a cell.
@@ -211,7 +229,22 @@ void SortedLine::ranks_of(std::size_t first, std::size_t count, std::uint64_t* m
     mask[word] = rank_bits_[(first + count) * 2 + word] & ~rank_bits_[first * 2 + word];
 }
 
-double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start) {
+VectorUnit widest_vector_unit() {
+#ifdef AMYTISS_HAS_AVX2_PASS
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return VectorUnit::Avx2;
+#endif
+  return VectorUnit::Baseline;
+}
+
+std::vector<VectorUnit> vector_units() {
+  std::vector<VectorUnit> units{VectorUnit::Baseline};
+  if (widest_vector_unit() == VectorUnit::Avx2) units.push_back(VectorUnit::Avx2);
+  return units;
+}
+
+double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
+                             VectorUnit unit) {
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;
   const double extra_keys[2] = {0.0, sign * cut_value(bound)};  // leave, cut
   const std::size_t outcomes = window.count + 2;
@@ -219,7 +252,7 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   // at most |t| + above * (1 + |t|), keys lying in [-1, 1].
   PassSums sums;
   auto sound_dual = [&](double t) {
-    sums = cells_pass(line.keys() + window.first, window.lo, window.hi, window.padded_count(), t);
+    sums = cells_pass(unit, line.keys() + window.first, window.lo, window.hi, window.padded_count(), t);
     add_outcome(sums, extra_keys[0], window.leave, t);
     add_outcome(sums, extra_keys[1], window.cut, t);
     const double error = robust_expectation_rounding(outcomes) * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));

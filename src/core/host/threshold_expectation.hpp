@@ -77,9 +77,17 @@ class SortedLine {
   std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
 };
 
+/// The instructions of the search's vectorised pass: the baseline's, or AVX2 with FMA (x86-64).
+enum class VectorUnit { Baseline, Avx2 };
+/// The widest unit this processor has; every unit it can run (the tests take each).
+VectorUnit widest_vector_unit();
+std::vector<VectorUnit> vector_units();
+
 /// The bound of one window over a sorted line: robust_expectation()'s up to rounding, moved
 /// outward by its error bound and clipped to [0, 1]. `start`: the rank whose key the search starts
-/// from on entry, where it ended on return (a good start for an overlapping window).
-double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start);
+/// from on entry, where it ended on return (a good start for an overlapping window). `unit`: one of
+/// vector_units(); every unit gives the same bound up to the order of additions.
+double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
+                             VectorUnit unit);
 
 }  // namespace amytiss::detail
