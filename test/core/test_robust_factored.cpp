@@ -96,12 +96,17 @@ TEST(RobustFactored, EveryOrderLiesWithinTheJointBounds) {
   } while (std::next_permutation(order.begin(), order.end()));
 }
 
-TEST(RobustFactored, SweepGivesEveryRowItsBoundInThePlansOrder) {
+// The sparse 3-d system, every row's bounds and the sweep's plan.
+class SparseSweep : public ::testing::Test {
+ protected:
   const Abstraction a = from_yaml(sparse_3d_yaml());
-  const ImageEnclosure enclosure(a.config);
+  const ImageEnclosure enclosure{a.config};
   const RowBounds rows = all_rows(a, enclosure);
   std::string reason;
   const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, &reason);
+};
+
+TEST_F(SparseSweep, GivesEveryRowItsBoundInThePlansOrder) {
   ASSERT_TRUE(plan) << reason;
   std::vector<DimensionView> views(a.states.dims());
   // The upper bound's sweep reuses the tensors the lower bound's left behind.
@@ -123,12 +128,7 @@ TEST(RobustFactored, SweepGivesEveryRowItsBoundInThePlansOrder) {
   }
 }
 
-TEST(RobustFactored, SweepGivesTheSameBitsOnAnyNumberOfWorkers) {
-  const Abstraction a = from_yaml(sparse_3d_yaml());
-  const ImageEnclosure enclosure(a.config);
-  const RowBounds rows = all_rows(a, enclosure);
-  std::string reason;
-  const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, &reason);
+TEST_F(SparseSweep, GivesTheSameBitsOnAnyNumberOfWorkers) {
   ASSERT_TRUE(plan) << reason;
   const std::vector<double> values = test_values(a.states.size()).front();
   for (Bound bound : {Bound::Lower, Bound::Upper}) {
