@@ -31,9 +31,10 @@ std::vector<std::string> describe_synthesis(const Abstraction& abstraction, cons
 /// Memory a synthesis needs, in bytes, as the OpenCL engine lays it out (docs/engine.md).
 struct MemoryEstimate {
   double policy_bytes = 0;             ///< policy arrays as in the file: float64 values of every
-                                       ///< step, uint32 input indices, uint8 roles
+                                       ///< step (and upper bounds), uint32 input indices, uint8 roles
   double bytes_per_triple = 0;         ///< one stored transition record: uint32 window offset +
-                                       ///< float32 cell masses of every dimension's window
+                                       ///< float32 cell masses of every dimension's window; 0 under
+                                       ///< guarantee: system, which stores no transitions
   double stored_transition_bytes = 0;  ///< bytes_per_triple times the state-input-disturbance triples
 };
 MemoryEstimate estimate_memory(const Abstraction& abstraction);

@@ -41,9 +41,14 @@ void print_sizes(const Abstraction& abstraction) {
 }
 
 // The engine's estimate (docs/engine.md): policy arrays as in the file, stored transitions as
-// the OpenCL engine stores them.
+// the OpenCL engine stores them; the continuous-system bounds store none.
 void print_memory_estimate(const Abstraction& abstraction) {
   const MemoryEstimate estimate = estimate_memory(abstraction);
+  if (abstraction.config.guarantee == Guarantee::System) {
+    std::printf("estimated memory: policy arrays %s (lower and upper bounds), no stored transitions\n",
+                format_bytes(estimate.policy_bytes).c_str());
+    return;
+  }
   std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",
               format_bytes(estimate.policy_bytes).c_str(), format_bytes(estimate.stored_transition_bytes).c_str(),
               estimate.bytes_per_triple);

@@ -32,6 +32,13 @@ MemoryEstimate estimate_memory(const Abstraction& abstraction) {
   MemoryEstimate estimate;
   estimate.policy_bytes = (horizon + 1) * cells * sizeof(double) + horizon * cells * sizeof(std::uint32_t) +
                           cells * sizeof(std::uint8_t);
+  // Upper bounds: one per cell for a stationary policy, one per value under guarantee: system.
+  const bool system = abstraction.config.guarantee == Guarantee::System;
+  if (abstraction.unbounded)
+    estimate.policy_bytes += cells * sizeof(double);
+  else if (system)
+    estimate.policy_bytes += (horizon + 1) * cells * sizeof(double);
+  if (system) return estimate;  // the bounds store no transitions, only per-dimension intervals
   estimate.bytes_per_triple = double(detail::Layout(abstraction).record_bytes());
   estimate.stored_transition_bytes = estimate.bytes_per_triple * double(abstraction.triples());
   return estimate;

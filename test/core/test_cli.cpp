@@ -166,7 +166,8 @@ TEST_F(CliTest, CompareReferenceComparesBothBoundsOfAnUnboundedPolicy) {
 }
 
 // guarantee: system prints both bounds, their gap and, with --compare-reference, how far each bound
-// is from the reference engine's (the joint interval MDP).
+// is from the reference engine's (the joint interval MDP); its memory estimate holds no stored
+// transitions.
 TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
   std::ifstream tiny(kTinyConfig);
   std::stringstream text;
@@ -180,8 +181,10 @@ TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
   for (const char* line :
        {"continuous-system bounds over", "lower (V_0, this policy) min", "upper (any controller)   min",
         "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
-        "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): "})
+        "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): ",
+        "(lower and upper bounds), no stored transitions"})
     EXPECT_CONTAINS(result.out, line);
+  EXPECT_EQ(result.out.find("bytes per triple"), std::string::npos) << "the bounds store no transitions";
 }
 
 // The number after `label` in the output, or NaN.
