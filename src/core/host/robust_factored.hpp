@@ -7,8 +7,8 @@
 // e_k reads (the bounds of any row with those components: host/row_bounds.hpp), leave worth 0 and
 // cut worth cut_value(bound), and Q = W_d holds every (cell, input, disturbance)'s bound. Each line
 // of W_{k-1} is read once: sorted, then every tuple applied to it by the threshold search
-// (threshold_expectation()), each search starting where the same tuple's ended on the line before,
-// so the stage keeps no sorted copy of its input.
+// (threshold_expectation()), each search starting where the search of the window in the same place
+// ended on the line before, so the stage keeps no sorted copy of its input.
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
 // stage may pick its distribution per remaining cell, a superset of the product set), and equal,

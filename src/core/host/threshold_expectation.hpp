@@ -17,7 +17,7 @@
 
 namespace amytiss::detail {
 
-/// Cells per pass of the search; windows are padded with zero intervals to a multiple of it.
+/// Cells per iteration of the search's pass; windows are padded with zero intervals to a multiple of it.
 constexpr std::size_t kThresholdLanes = 4;
 
 /// A window as the search reads it: cells first .. first + count - 1 of the line, their lower and
