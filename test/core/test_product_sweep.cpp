@@ -187,7 +187,8 @@ TEST(ProductSweep, SweepsSharingBuffersGiveWhatEachGivesAlone) {
   }
 }
 
-void expect_shared_bounds_are_own(const std::string& yaml, const std::vector<std::vector<std::size_t>>& expected_reads) {
+void expect_shared_bounds_are_own(const std::string& yaml,
+                                  const std::vector<std::vector<std::size_t>>& expected_reads) {
   const Abstraction a = from_yaml(yaml);
   const ImageEnclosure enclosure(a.config);
   const std::vector<std::vector<std::size_t>> reads = bounds_reads(a);
