@@ -74,11 +74,11 @@ class RobustFactoredSweep {
   FactoredPlan plan_;
   Bound bound_;
   unsigned threads_;
-  std::vector<std::size_t> counts_;                  // state cells per dimension
-  std::vector<PackedWindows> packed_;               // [dimension]: the window of each tuple
-  VectorUnit unit_ = widest_vector_unit();          // the searches' passes
-  std::vector<StageWalk> walks_;                     // per stage
-  std::shared_ptr<SweepBuffers> buffers_;            // the ping-pong W_k
+  std::vector<std::size_t> counts_;        // state cells per dimension
+  std::vector<PackedWindows> packed_;      // [dimension]: the window of each tuple
+  VectorUnit unit_ = widest_vector_unit();  // the searches' passes
+  std::vector<StageWalk> walks_;           // per stage
+  std::shared_ptr<SweepBuffers> buffers_;  // the ping-pong W_k
   std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;
 };

@@ -160,9 +160,7 @@ PackedWindows::PackedWindows(const std::vector<DimensionView>& windows) {
   std::size_t total = 0;
   for (const DimensionView& window : windows) {
     window_sums(window);  // a feasible row, or std::logic_error
-    PackedWindow sized;
-    sized.count = window.count;
-    total += sized.padded_count();
+    total += PackedWindow::padded(window.count);
   }
   lo_.assign(total, 0.0);
   hi_.assign(total, 0.0);
@@ -269,8 +267,8 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   const double step_rounding = robust_expectation_rounding(outcomes + 2);
   const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
   double slope_weight = direction > 0 ? sums.above : sums.below, dual = best;
-  std::size_t steps = 0;
-  for (; direction != 0 && steps < outcomes; ++steps) {
+  std::size_t steps = 0;  // taken
+  while (direction != 0 && steps < outcomes) {
     const Group next = next_group(line, window, extra_keys, t, start, direction);
     if (std::abs(next.key) == kInfinity) break;
     dual += (next.key - t) * (1.0 - slope_weight) - step_rounding * (1.0 + slope_weight);
@@ -278,6 +276,7 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
     t = next.key;
     start = next.rank;
     slope_weight += direction * next.slack;
+    ++steps;
     if (direction > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
   }
   if (steps > kStepsInOnePass) best = std::max(best, sound_dual(t));

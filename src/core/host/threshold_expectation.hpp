@@ -27,7 +27,10 @@ struct PackedWindow {
   const double* lo = nullptr;
   const double* hi = nullptr;
   MassInterval leave, cut;
-  std::size_t padded_count() const { return (count + kThresholdLanes - 1) / kThresholdLanes * kThresholdLanes; }
+  std::size_t padded_count() const { return padded(count); }
+  static std::size_t padded(std::size_t count) {
+    return (count + kThresholdLanes - 1) / kThresholdLanes * kThresholdLanes;
+  }
 };
 
 /// The windows of one dimension, packed (views into storage the object owns; not copyable).
