@@ -291,6 +291,37 @@ TEST(Enclosure, RobustReferenceBoundsFromEnclosures) {
   }
 }
 
+// The mean boxes hold the enclosures, rounded outward to a binary grid of at most 2^-40 of a
+// cell; images equal in exact arithmetic then give equal boxes: 0.36 x0 + 0.18 x1 at cells
+// i, j and i + 1, j - 2 of a grid of 0.1.
+TEST(Enclosure, MeanBoxesAreTheEnclosuresOnABinaryGrid) {
+  const Grid states(test_support::grid_spec({0.0, 0.0}, {1.6, 1.6}, {0.1, 0.1}));
+  const Grid none;
+  const ImageEnclosure enclosure(dynamics_config({"0.36*x0 + 0.18*x1", "x1"}));
+  const detail::MeanBox mean_box = detail::enclosure_mean_box(enclosure, states, none, none);
+  const double quantum = std::ldexp(0.1, -40);
+  std::size_t equal_pairs = 0;
+  for (std::size_t i = 0; i + 1 < states.count(0); ++i)
+    for (std::size_t j = 2; j < states.count(1); ++j) {
+      const std::size_t cell = i * states.count(1) + j, neighbour = (i + 1) * states.count(1) + j - 2;
+      double lo[2], hi[2], other_lo[2], other_hi[2];
+      mean_box(cell, 0, 0, lo, hi);
+      mean_box(neighbour, 0, 0, other_lo, other_hi);
+      const std::vector<double> centre = states.point(cell);
+      const ImageBox image = enclosure.enclose(
+          {Interval(centre[0] - 0.05, centre[0] + 0.05), Interval(centre[1] - 0.05, centre[1] + 0.05)}, {}, {});
+      for (std::size_t d = 0; d < 2; ++d) {
+        EXPECT_LE(lo[d], image.box[d].lo);
+        EXPECT_GE(hi[d], image.box[d].hi);
+        EXPECT_LE(image.box[d].lo - lo[d], quantum);
+        EXPECT_LE(hi[d] - image.box[d].hi, quantum);
+      }
+      equal_pairs += lo[0] == other_lo[0] && hi[0] == other_hi[0];
+    }
+  // 16 x 15 pairs; a box next to a point of the grid might round apart from its neighbour's.
+  EXPECT_GE(equal_pairs, 16u * 15u - 2u);
+}
+
 // Safety on [-1, 1] of x+ = f(x) + N(0, sigma^2) by composite Simpson (kNodes points per cell of
 // 0.1): V_T = 1, V_k(x) = integral over [-1, 1] of N(y; f(x), sigma^2) V_{k+1}(y) dy.
 std::vector<std::vector<double>> continuous_safety(const Expression& f, double sigma, unsigned horizon) {

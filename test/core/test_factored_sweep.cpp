@@ -82,6 +82,39 @@ TEST(FactoredPlan, TrafficReadsTwoStatesAndOneInputPerCoordinate) {
   EXPECT_LT(plan->multiply_adds * 5, plan->dense_multiply_adds) << plan->describe();
 }
 
+// The host's line-by-line layout: each stage's output keeps its input's digits in order, less the
+// contracted cell, and ends with the variables new to the stage (one line's results side by
+// side); Q's states come first; no stage has a vector digit.
+TEST(FactoredPlan, LinesLayoutWritesEachLinesResultsSideBySide) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
+  std::string reason;
+  const auto plan =
+      detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason, detail::FactoredLayout::Lines);
+  ASSERT_TRUE(plan) << reason;
+  std::vector<detail::TensorDigit> input;
+  for (std::size_t d = 0; d < a.states.dims(); ++d) input.push_back({true, d, a.states.count(d)});
+  for (std::size_t k = 0; k + 1 < plan->stages.size(); ++k) {
+    const detail::FactoredStage& stage = plan->stages[k];
+    EXPECT_FALSE(stage.vector_digit);
+    std::size_t j = 0;
+    for (const detail::TensorDigit& digit : input) {
+      if (digit.post && digit.id == stage.dimension) continue;
+      ASSERT_LT(j, stage.output.size());
+      EXPECT_TRUE(stage.output[j].post == digit.post && stage.output[j].id == digit.id) << "stage " << k;
+      EXPECT_NE(stage.input_stride[j++], 0u);
+    }
+    for (; j < stage.output.size(); ++j) {
+      EXPECT_FALSE(stage.output[j].post) << "stage " << k;
+      EXPECT_EQ(stage.input_stride[j], 0u) << "stage " << k;
+    }
+    input = stage.output;
+  }
+  const std::vector<detail::TensorDigit>& q = plan->stages.back().output;
+  EXPECT_TRUE(std::is_partitioned(q.begin(), q.end(), [&](const detail::TensorDigit& digit) {
+    return plan->variables[digit.id].space == detail::FactorVariable::Space::State;
+  }));
+}
+
 TEST(FactoredPlan, SlicesWhenTheTensorsDoNotFitAndRefusesWhatCannotFit) {
   const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
   std::string reason;

@@ -4,7 +4,8 @@
 // on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
 // without slack, and leave or cut taking the whole budget, the search gives robust_expectation()'s
 // bound within rounding, never past the exact value's sound side, and ends on a rank of the line,
-// with each vector unit the processor has (AVX2 and the baseline giving the same search).
+// with each vector unit the processor has (AVX2 and the baseline giving the same search); so does
+// the search of an unsorted line.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,7 +75,12 @@ TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderItsRunsAndEachWindows
   }
 }
 
-TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundSide) {
+// For each vector unit, on random lines and windows, from the first, middle and last starts and a
+// random one: search(line's values, window, bound, start (in and out), unit) gives
+// robust_expectation()'s bound within rounding, on the exact value's sound side of it, and ends
+// on an index of the line.
+template <typename Search>
+void expect_the_sorted_bound_from_any_start(Search&& search) {
   for (VectorUnit unit : vector_units()) {
     std::mt19937 random(kSeed);
     for (std::size_t length : kLengths)
@@ -86,12 +92,11 @@ TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundS
         const PackedWindows packed(std::vector<DimensionView>{row.window});
         const double rounding = robust_expectation_rounding(row.cells.size() + 2);
         for (Bound bound : {Bound::Lower, Bound::Upper}) {
-          const SortedLine line = sorted_line(values, bound);
           const double sorted = sorted_expectation(values, row, bound);
-          std::uniform_int_distribution<std::size_t> any_rank(0, length - 1);
-          for (std::size_t start : {std::size_t(0), length / 2, length - 1, any_rank(random)}) {
+          std::uniform_int_distribution<std::size_t> any_start(0, length - 1);
+          for (std::size_t start : {std::size_t(0), length / 2, length - 1, any_start(random)}) {
             std::size_t end = start;
-            const double bound_value = threshold_expectation(line, packed[0], bound, end, unit);
+            const double bound_value = search(values, packed[0], bound, end, unit);
             ASSERT_LT(end, length);
             EXPECT_NEAR(bound_value, sorted, kAgreement)
                 << "length " << length << " trial " << trial << " start " << start;
@@ -105,6 +110,23 @@ TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundS
         }
       }
   }
+}
+
+TEST(ThresholdExpectation, FromAnyStartItIsTheSortedOneWithinRoundingOnItsSoundSide) {
+  expect_the_sorted_bound_from_any_start([](const std::vector<double>& values, const PackedWindow& window, Bound bound,
+                                            std::size_t& start, VectorUnit unit) {
+    return threshold_expectation(sorted_line(values, bound), window, bound, start, unit);  // start: a rank
+  });
+}
+
+// The search without a sort, from a position of the line.
+TEST(ThresholdExpectation, TheScanFromAnyStartIsTheSortedOneWithinRoundingOnItsSoundSide) {
+  expect_the_sorted_bound_from_any_start([](const std::vector<double>& values, const PackedWindow& window, Bound bound,
+                                            std::size_t& start, VectorUnit unit) {
+    std::vector<double> keys(values.size() + kThresholdLanes, 0.0);
+    for (std::size_t a = 0; a < values.size(); ++a) keys[a] = (bound == Bound::Lower ? 1.0 : -1.0) * values[a];
+    return threshold_scan(keys.data(), window, bound, start, unit);
+  });
 }
 
 TEST(ThresholdExpectation, EveryVectorUnitGivesTheBaselinesBoundUpToTheOrderOfAdditions) {

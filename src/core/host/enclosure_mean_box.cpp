@@ -1,9 +1,24 @@
 #include "host/enclosure_mean_box.hpp"
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
 namespace amytiss::detail {
+namespace {
+
+// The power of two at most 2^-40 of `width`, and the multiples of it just outside x. Floor and
+// ceiling of a quotient by a power of two are exact; a value of magnitude 2^52 quanta or more is
+// a multiple of the quantum already.
+double binary_quantum(double width) { return std::ldexp(1.0, std::ilogb(width) - 40); }
+double floor_to(double x, double quantum) {
+  return std::abs(x) < std::ldexp(quantum, 52) ? std::floor(x / quantum) * quantum : x;
+}
+double ceil_to(double x, double quantum) {
+  return std::abs(x) < std::ldexp(quantum, 52) ? std::ceil(x / quantum) * quantum : x;
+}
+
+}  // namespace
 
 MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,
                            const Grid& disturbances) {
@@ -18,8 +33,13 @@ MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, 
     const ImageBox image = enclosure.enclose(box, u, w);
     constexpr double kInfinity = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < image.box.size(); ++i) {
-      lo[i] = image.defined && !image.box[i].is_empty() ? image.box[i].lo : -kInfinity;
-      hi[i] = image.defined && !image.box[i].is_empty() ? image.box[i].hi : kInfinity;
+      const bool known = image.defined && !image.box[i].is_empty();
+      // Rounded outward to a binary grid far finer than the cell: boxes equal in exact arithmetic
+      // (a linear map on the grid gives many cells one mean) are then equal bit for bit, and share
+      // one entry of bounds and one search per line of the variable elimination.
+      const double quantum = binary_quantum(states.eta()[i]);
+      lo[i] = known ? floor_to(image.box[i].lo, quantum) : -kInfinity;
+      hi[i] = known ? ceil_to(image.box[i].hi, quantum) : kInfinity;
     }
   };
 }

@@ -37,7 +37,7 @@ std::size_t window_width(const Abstraction& a, std::size_t dim) {
 
 // Entries of W_k for k = 1..d in the order (the sliced dimension, order.back(), at full size),
 // the multiply-adds of all stages, and the cost the order is chosen by: multiply-adds, a stage
-// without a vector digit (see build_stages) weighted by kScalarStageWeight.
+// without a vector digit (see build_stages) weighted by kScalarStageWeight in the kernels' layout.
 struct OrderCost {
   std::vector<double> sizes;
   double multiply_adds = 0;
@@ -50,7 +50,7 @@ constexpr double kScalarStageWeight = 8.0;
 
 OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<std::vector<std::size_t>>& reads,
                      const std::vector<FactorVariable>& variables, const std::vector<std::size_t>& counts,
-                     const std::vector<std::size_t>& widths) {
+                     const std::vector<std::size_t>& widths, FactoredLayout layout) {
   OrderCost cost;
   const std::size_t dims = counts.size();
   std::vector<char> used(variables.size(), 0), remaining(dims, 1);
@@ -82,14 +82,16 @@ OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<st
     }
     cost.sizes.push_back(size);
     cost.multiply_adds += size * double(widths[dim]);
-    cost.weighted += size * double(widths[dim]) * (vector ? 1.0 : kScalarStageWeight);
+    const bool weighted = !vector && layout == FactoredLayout::Kernels;
+    cost.weighted += size * double(widths[dim]) * (weighted ? kScalarStageWeight : 1.0);
   }
   return cost;
 }
 
 std::vector<std::size_t> greedy_order(const std::vector<std::vector<std::size_t>>& reads,
                                       const std::vector<FactorVariable>& variables,
-                                      const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths) {
+                                      const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths,
+                                      FactoredLayout layout) {
   std::vector<std::size_t> order, left(counts.size());
   std::iota(left.begin(), left.end(), 0);
   while (!left.empty()) {
@@ -98,7 +100,7 @@ std::vector<std::size_t> greedy_order(const std::vector<std::vector<std::size_t>
     for (std::size_t j = 0; j < left.size(); ++j) {
       std::vector<std::size_t> trial = order;
       trial.push_back(left[j]);
-      const double cost = order_cost(trial, reads, variables, counts, widths).weighted;
+      const double cost = order_cost(trial, reads, variables, counts, widths, layout).weighted;
       if (cost < best_cost) {
         best_cost = cost;
         best = j;
@@ -169,14 +171,42 @@ std::vector<std::optional<DigitId>> vector_digits(const std::vector<std::size_t>
   return digits;
 }
 
+// The final layout of stage k's output, from the input's digits and then the new variables.
+void arrange_output(std::vector<TensorDigit>& output, std::size_t k, const std::vector<std::size_t>& order,
+                    const std::vector<std::optional<DigitId>>& vectors, const std::vector<FactorVariable>& variables,
+                    FactoredLayout layout) {
+  // Q: input and disturbance digits last, so that the input choice reads each state's values
+  // from one stretch of memory.
+  if (k + 1 == order.size())
+    std::stable_partition(output.begin(), output.end(), [&](const TensorDigit& digit) {
+      return variables[digit.id].space == FactorVariable::Space::State;
+    });
+  if (layout == FactoredLayout::Lines) return;
+  // The next stage's contracted cell goes just before its vector digit: each work-item's
+  // window is then one contiguous block of the next input.
+  if (k + 1 < order.size()) {
+    const auto next = std::find_if(output.begin(), output.end(), [&](const TensorDigit& digit) {
+      return digit.post && digit.id == order[k + 1];
+    });
+    std::rotate(next, next + 1, output.end());
+  }
+  if (k + 1 < order.size() && vectors[k + 1]) {
+    const auto next = std::find_if(output.begin(), output.end(), [&](const TensorDigit& digit) {
+      return digit.post == vectors[k + 1]->post && digit.id == vectors[k + 1]->id;
+    });
+    std::rotate(next, next + 1, output.end());
+  }
+}
+
 // Stages of an order for slices of `slice_cells` cells of the last dimension eliminated.
 std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
                                         const std::vector<std::vector<std::size_t>>& reads,
                                         const std::vector<FactorVariable>& variables,
                                         const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths,
-                                        std::size_t slice_cells) {
+                                        std::size_t slice_cells, FactoredLayout layout) {
   const std::size_t dims = counts.size(), sliced = order.back();
-  const std::vector<std::optional<DigitId>> vectors = vector_digits(order, reads, variables, counts, slice_cells);
+  std::vector<std::optional<DigitId>> vectors = vector_digits(order, reads, variables, counts, slice_cells);
+  if (layout == FactoredLayout::Lines) vectors.assign(order.size(), std::nullopt);
   std::vector<TensorDigit> input;
   for (std::size_t r = 0; r < dims; ++r) input.push_back({true, r, counts[r]});  // V, unsliced
   std::vector<char> used(variables.size(), 0), remaining(dims, 1);
@@ -188,36 +218,16 @@ std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
     FactoredStage stage;
     stage.dimension = dim;
     stage.width = widths[dim];
-    // Layout: the input's digits in the input's order (so that work-items stream the input), then
-    // the variables new to this stage (neighbouring work-items then differ in masses only and
-    // re-read the same window of values from cache), then the next stage's contracted cell and
-    // vector digit.
+    // The input's digits in the input's order (so that work-items stream the input), then the
+    // variables new to this stage (neighbouring work-items then differ in masses only and re-read
+    // the same window of values from cache).
     for (const TensorDigit& digit : input)
       if (!(digit.post && digit.id == dim))
         stage.output.push_back({digit.post, digit.id, digit.post && digit.id == sliced ? slice_cells : digit.radix});
     for (std::size_t v : reads[dim])
       if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
         stage.output.push_back({false, v, variables[v].count});
-    // Q: input and disturbance digits last, so that the input choice reads each state's values
-    // from one stretch of memory.
-    if (k + 1 == order.size())
-      std::stable_partition(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
-        return variables[digit.id].space == FactorVariable::Space::State;
-      });
-    // The next stage's contracted cell goes just before its vector digit: each work-item's
-    // window is then one contiguous block of the next input.
-    if (k + 1 < order.size()) {
-      const auto next = std::find_if(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
-        return digit.post && digit.id == order[k + 1];
-      });
-      std::rotate(next, next + 1, stage.output.end());
-    }
-    if (k + 1 < order.size() && vectors[k + 1]) {
-      const auto next = std::find_if(stage.output.begin(), stage.output.end(), [&](const TensorDigit& digit) {
-        return digit.post == vectors[k + 1]->post && digit.id == vectors[k + 1]->id;
-      });
-      std::rotate(next, next + 1, stage.output.end());
-    }
+    arrange_output(stage.output, k, order, vectors, variables, layout);
     const std::vector<std::uint64_t> input_strides = strides_of(input);
     std::vector<std::uint64_t> tuple_strides(variables.size(), 0);
     std::uint64_t tuple_stride = 1;
@@ -304,12 +314,14 @@ std::vector<std::vector<std::size_t>> coordinate_reads(const Abstraction& a, con
   return all;
 }
 
-// The cheapest order; among equally cheap ones, the one with the smallest tensors.
+// The cheapest order (the kernels' weighted cost, or the lines' multiply-adds); among equally
+// cheap ones, the one with the smallest tensors.
 std::vector<std::size_t> cheapest_order(const FactoredPlan& plan, const std::vector<std::size_t>& counts,
-                                        const std::vector<std::size_t>& widths, OrderCost& best_cost) {
+                                        const std::vector<std::size_t>& widths, FactoredLayout layout,
+                                        OrderCost& best_cost) {
   std::vector<std::size_t> best_order;
   auto consider = [&](const std::vector<std::size_t>& order) {
-    OrderCost cost = order_cost(order, plan.reads, plan.variables, counts, widths);
+    OrderCost cost = order_cost(order, plan.reads, plan.variables, counts, widths, layout);
     const double largest = *std::max_element(cost.sizes.begin(), cost.sizes.end());
     const double best_largest =
         best_order.empty() ? INFINITY : *std::max_element(best_cost.sizes.begin(), best_cost.sizes.end());
@@ -326,7 +338,7 @@ std::vector<std::size_t> cheapest_order(const FactoredPlan& plan, const std::vec
     do consider(order);
     while (std::next_permutation(order.begin(), order.end()));
   } else {
-    consider(greedy_order(plan.reads, plan.variables, counts, widths));
+    consider(greedy_order(plan.reads, plan.variables, counts, widths, layout));
   }
   return best_order;
 }
@@ -366,7 +378,7 @@ void choose_slices(const Abstraction& a, const OrderCost& cost, const std::vecto
 }  // namespace
 
 std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double budget_bytes, double max_buffer_bytes,
-                                                std::string* reason) {
+                                                std::string* reason, FactoredLayout layout) {
   auto refuse = [&](const std::string& why) -> std::optional<FactoredPlan> {
     if (reason) *reason = why;
     return std::nullopt;
@@ -385,7 +397,7 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
   }
   plan.reads = coordinate_reads(a, *dependencies);
   OrderCost best_cost;
-  plan.order = cheapest_order(plan, counts, widths, best_cost);
+  plan.order = cheapest_order(plan, counts, widths, layout, best_cost);
   if (*std::max_element(best_cost.sizes.begin(), best_cost.sizes.end()) > kMaxTensorEntries)
     return refuse("its tensors would exceed 64-bit indexing");
   plan.multiply_adds = best_cost.multiply_adds;
@@ -397,7 +409,7 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
     return refuse("its tensors need more than the budget of " + format_bytes(budget_bytes) + " (or buffers above " +
                   format_bytes(max_buffer_bytes) + ") even in slices");
   plan.slice_cells = counts[plan.order.back()] / plan.slices;
-  plan.stages = build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells);
+  plan.stages = build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells, layout);
   for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
     plan.largest_stage_tensor = std::max(plan.largest_stage_tensor, plan.stages[k].output_size);
   const FactoredStage& last = plan.stages.back();

@@ -80,10 +80,19 @@ std::size_t dense_window_width(const Abstraction& abstraction, std::size_t dim);
 /// Nominal multiply-adds of one separable contraction of the problem's window.
 double contraction_multiply_adds(const Abstraction& abstraction);
 
+/// How a plan lays out its tensors. Kernels: for the OpenCL stages, each stage's output ends with
+/// the next stage's contracted cell and vector digit (work-items read contiguous windows). Lines:
+/// for a host sweep that contracts one line at a time and applies every tuple of new variables to
+/// it, the output keeps the input's order and ends with the new variables, so each line's results
+/// are written contiguously; the order is chosen by multiply-adds alone, and no stage has a
+/// vector digit.
+enum class FactoredLayout { Kernels, Lines };
+
 /// The cheapest elimination order whose buffers fit `budget_bytes` in all and `max_buffer_bytes`
 /// each, or nullopt with the reason (dynamics without dependency information, non-separable
 /// noise, nothing fits).
 std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& abstraction, double budget_bytes,
-                                                double max_buffer_bytes, std::string* reason);
+                                                double max_buffer_bytes, std::string* reason,
+                                                FactoredLayout layout = FactoredLayout::Kernels);
 
 }  // namespace amytiss::detail

@@ -41,6 +41,7 @@ class PackedWindows {
   PackedWindows& operator=(const PackedWindows&) = delete;
   PackedWindows(PackedWindows&&) = default;
   const PackedWindow& operator[](std::size_t k) const { return views_[k]; }
+  std::size_t size() const { return views_.size(); }
 
  private:
   std::vector<double> lo_, hi_;
@@ -68,6 +69,8 @@ class SortedLine {
   /// The first and last rank of r's run of equal keys.
   std::size_t run_first(std::size_t r) const { return run_first_[r]; }
   std::size_t run_last(std::size_t r) const { return run_last_[r]; }
+  /// Keys in the longest run of equal keys.
+  std::size_t longest_run() const { return longest_run_; }
   /// Lines up to kMaskedLength long: the ranks of positions first .. first + count - 1 as bits of
   /// two words.
   void ranks_of(std::size_t first, std::size_t count, std::uint64_t* mask) const;
@@ -75,6 +78,7 @@ class SortedLine {
  private:
   std::size_t length_;
   bool sorted_before_ = false;
+  std::size_t longest_run_ = 0;
   std::vector<double> keys_;
   std::vector<std::uint32_t> order_, rank_, run_first_, run_last_;
   std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
@@ -92,5 +96,13 @@ std::vector<VectorUnit> vector_units();
 /// vector_units(); every unit gives the same bound up to the order of additions.
 double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
                              VectorUnit unit);
+
+/// The same bound without a sorted line, for lines that few windows read (a sort would cost more
+/// than it saves): each step is a pass over the window. `keys`: the line's keys (as SortedLine
+/// holds them) followed by kThresholdLanes readable entries. `start`: the position whose key the
+/// search starts from on entry, on return the position of the last cell it stepped to (unchanged
+/// when none).
+double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,
+                      VectorUnit unit);
 
 }  // namespace amytiss::detail
