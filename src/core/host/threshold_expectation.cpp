@@ -19,7 +19,7 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr std::size_t kNoPosition = ~std::size_t(0);
-// Runs of equal keys up to this long are walked to find the slack at a threshold.
+// Runs of equal keys shorter than this are walked to find the slack at a threshold.
 constexpr std::size_t kShortRun = 8;
 
 typedef double Lanes __attribute__((vector_size(kThresholdLanes * sizeof(double))));
@@ -31,6 +31,7 @@ typedef long LaneMask __attribute__((vector_size(kThresholdLanes * sizeof(double
 __attribute__((always_inline)) inline Lanes select(LaneMask mask, Lanes a, Lanes b) {
   return reinterpret_cast<Lanes>((mask & reinterpret_cast<LaneMask>(a)) | (~mask & reinterpret_cast<LaneMask>(b)));
 }
+
 __attribute__((always_inline)) inline LaneMask select(LaneMask mask, LaneMask a, LaneMask b) {
   return (mask & a) | (~mask & b);
 }
@@ -287,11 +288,8 @@ void SortedLine::sort(bool from_last) {
   sorted_before_ = true;
   for (std::size_t r = 0; r < length_; ++r)
     run_first_[r] = r > 0 && keys_[order_[r]] == keys_[order_[r - 1]] ? run_first_[r - 1] : std::uint32_t(r);
-  longest_run_ = 0;
-  for (std::size_t r = length_; r-- > 0;) {
+  for (std::size_t r = length_; r-- > 0;)
     run_last_[r] = r + 1 < length_ && keys_[order_[r]] == keys_[order_[r + 1]] ? run_last_[r + 1] : std::uint32_t(r);
-    longest_run_ = std::max<std::size_t>(longest_run_, run_last_[r] - run_first_[r] + 1);
-  }
   if (rank_bits_.empty()) return;
   // Ranks are distinct: the bits of positions first .. last - 1 are prefix(last) minus prefix(first).
   for (std::size_t position = 0; position < length_; ++position) {
@@ -327,9 +325,9 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   const std::size_t outcomes = window.count + 2;
   PassSums sums;
   double t = line.keys()[line.order(start)];
-  // The pass leaves out D's weights below t where they are a short run's slack away; on a line
-  // with long runs of equal keys (plateaus of values) it sums them too.
-  const bool long_runs = line.longest_run() > kShortRun;
+  // The pass leaves out D's weights below t where they are a short run's slack away; where t's
+  // run of equal keys is long (a plateau of values) it sums them too.
+  const bool long_runs = line.run_last(start) - line.run_first(start) >= kShortRun;
   double best = long_runs ? sound_dual<PassKind::Below>(unit, line.keys(), window, extra_keys, t, sums)
                           : sound_dual<PassKind::Above>(unit, line.keys(), window, extra_keys, t, sums);
   // D is linear between neighbouring keys with slack: with slope 1 - above above t, 1 - below

@@ -69,8 +69,6 @@ class SortedLine {
   /// The first and last rank of r's run of equal keys.
   std::size_t run_first(std::size_t r) const { return run_first_[r]; }
   std::size_t run_last(std::size_t r) const { return run_last_[r]; }
-  /// Keys in the longest run of equal keys.
-  std::size_t longest_run() const { return longest_run_; }
   /// Lines up to kMaskedLength long: the ranks of positions first .. first + count - 1 as bits of
   /// two words.
   void ranks_of(std::size_t first, std::size_t count, std::uint64_t* mask) const;
@@ -78,7 +76,6 @@ class SortedLine {
  private:
   std::size_t length_;
   bool sorted_before_ = false;
-  std::size_t longest_run_ = 0;
   std::vector<double> keys_;
   std::vector<std::uint32_t> order_, rank_, run_first_, run_last_;
   std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
