@@ -83,30 +83,40 @@ TEST(FactoredPlan, TrafficReadsTwoStatesAndOneInputPerCoordinate) {
 }
 
 // The host's line-by-line layout: each stage's output keeps its input's digits in order, less the
-// contracted cell, and ends with the variables new to the stage (one line's results side by
-// side); Q's states come first; no stage has a vector digit.
+// contracted cell, then the variables new to the stage (one line's results side by side), then
+// the largest remaining post cell that the next stage does not contract (the next stage's
+// neighbouring lines); Q's states come first; no stage has a vector digit.
 TEST(FactoredPlan, LinesLayoutWritesEachLinesResultsSideBySide) {
   const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
   std::string reason;
   const auto plan =
       detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason, detail::FactoredLayout::Lines);
   ASSERT_TRUE(plan) << reason;
+  auto same = [](const detail::TensorDigit& x, const detail::TensorDigit& y) {
+    return x.post == y.post && x.id == y.id;
+  };
   std::vector<detail::TensorDigit> input;
   for (std::size_t d = 0; d < a.states.dims(); ++d) input.push_back({true, d, a.states.count(d)});
   for (std::size_t k = 0; k + 1 < plan->stages.size(); ++k) {
     const detail::FactoredStage& stage = plan->stages[k];
     EXPECT_FALSE(stage.vector_digit);
-    std::size_t j = 0;
-    for (const detail::TensorDigit& digit : input) {
-      if (digit.post && digit.id == stage.dimension) continue;
-      ASSERT_LT(j, stage.output.size());
-      EXPECT_TRUE(stage.output[j].post == digit.post && stage.output[j].id == digit.id) << "stage " << k;
-      EXPECT_NE(stage.input_stride[j++], 0u);
+    std::vector<detail::TensorDigit> expected;
+    for (const detail::TensorDigit& digit : input)
+      if (!(digit.post && digit.id == stage.dimension)) expected.push_back(digit);
+    for (std::size_t v : plan->reads[stage.dimension]) {
+      const detail::TensorDigit variable{false, v, plan->variables[v].count};
+      const auto is_variable = [&](const detail::TensorDigit& digit) { return same(digit, variable); };
+      if (std::none_of(input.begin(), input.end(), is_variable)) expected.push_back(variable);
     }
-    for (; j < stage.output.size(); ++j) {
-      EXPECT_FALSE(stage.output[j].post) << "stage " << k;
-      EXPECT_EQ(stage.input_stride[j], 0u) << "stage " << k;
-    }
+    auto last = expected.end();
+    for (auto digit = expected.begin(); digit != expected.end(); ++digit)
+      if (digit->post && digit->id != plan->stages[k + 1].dimension &&
+          (last == expected.end() || digit->radix > last->radix))
+        last = digit;
+    if (last != expected.end()) std::rotate(last, last + 1, expected.end());
+    ASSERT_EQ(stage.output.size(), expected.size());
+    for (std::size_t j = 0; j < expected.size(); ++j)
+      EXPECT_TRUE(same(stage.output[j], expected[j])) << "stage " << k << " digit " << j;
     input = stage.output;
   }
   const std::vector<detail::TensorDigit>& q = plan->stages.back().output;

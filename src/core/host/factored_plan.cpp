@@ -181,7 +181,17 @@ void arrange_output(std::vector<TensorDigit>& output, std::size_t k, const std::
     std::stable_partition(output.begin(), output.end(), [&](const TensorDigit& digit) {
       return variables[digit.id].space == FactorVariable::Space::State;
     });
-  if (layout == FactoredLayout::Lines) return;
+  if (layout == FactoredLayout::Lines) {
+    // The largest remaining post cell that the next stage does not contract goes last: the next
+    // stage's consecutive lines then differ in it alone (neighbouring cells of the value
+    // function: close values, the same windows) and lie side by side in memory.
+    auto last = output.end();
+    for (auto digit = output.begin(); k + 1 < order.size() && digit != output.end(); ++digit)
+      if (digit->post && digit->id != order[k + 1] && (last == output.end() || digit->radix > last->radix))
+        last = digit;
+    if (last != output.end()) std::rotate(last, last + 1, output.end());
+    return;
+  }
   // The next stage's contracted cell goes just before its vector digit: each work-item's
   // window is then one contiguous block of the next input.
   if (k + 1 < order.size()) {

@@ -83,9 +83,10 @@ double contraction_multiply_adds(const Abstraction& abstraction);
 /// How a plan lays out its tensors. Kernels: for the OpenCL stages, each stage's output ends with
 /// the next stage's contracted cell and vector digit (work-items read contiguous windows). Lines:
 /// for a host sweep that contracts one line at a time and applies every tuple of new variables to
-/// it, the output keeps the input's order and ends with the new variables, so each line's results
-/// are written contiguously; the order is chosen by multiply-adds alone, and no stage has a
-/// vector digit.
+/// it, the output keeps the input's order, then the new variables (a line's results side by side),
+/// then the largest remaining post cell that the next stage does not contract (the next stage's
+/// neighbouring lines: close values, the same windows, side by side in memory); the order is
+/// chosen by multiply-adds alone, and no stage has a vector digit.
 enum class FactoredLayout { Kernels, Lines };
 
 /// The cheapest elimination order whose buffers fit `budget_bytes` in all and `max_buffer_bytes`

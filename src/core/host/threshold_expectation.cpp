@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "host/ordered_expectation.hpp"
 
@@ -19,8 +20,6 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr std::size_t kNoPosition = ~std::size_t(0);
-// Runs of equal keys shorter than this are walked to find the slack at a threshold.
-constexpr std::size_t kShortRun = 8;
 
 typedef double Lanes __attribute__((vector_size(kThresholdLanes * sizeof(double))));
 typedef long LaneMask __attribute__((vector_size(kThresholdLanes * sizeof(double))));
@@ -41,21 +40,26 @@ __attribute__((always_inline)) inline LaneMask select(LaneMask mask, LaneMask a,
 struct PassSums {
   double above = 0.0;     // sum of (key > t ? lo : hi): 1 - D's slope just above t; D's weights
   double weighted = 0.0;  // sum of key * (key > t ? lo : hi)
-  double below = 0.0;     // with neighbours: sum of (key < t ? hi : lo), 1 - D's slope just below t
-  // With neighbours: the nearest keys with slack above and below t (+-infinity: none), and the
-  // position of one cell of each in the window (kNoPosition: none, or leave or cut).
+  double below = 0.0;     // sum of (key < t ? hi : lo): 1 - D's slope just below t
+};
+// And the nearest keys with slack above and below t (+-infinity: none), with the position of one
+// cell of each in the window (kNoPosition: none, or leave or cut). Apart: the sorted search's
+// passes return the smaller struct.
+struct ScanSums : PassSums {
   double up = kInfinity, down = -kInfinity;
   std::size_t up_position = kNoPosition, down_position = kNoPosition;
 };
 
-// What a pass computes besides D's weights above t and its weighted keys: the weights below t
-// too, or those and the neighbouring keys.
-enum class PassKind { Above, Below, Neighbours };
+// What a pass computes: D's value and the weights of its slope either side of t, and with them
+// the neighbouring keys.
+enum class PassKind { Slopes, Neighbours };
+template <PassKind kKind>
+using SumsOf = std::conditional_t<kKind == PassKind::Neighbours, ScanSums, PassSums>;
 
 // The pass's body, inlined into one function per instruction set.
 template <PassKind kKind>
-__attribute__((always_inline)) inline PassSums pass_body(const double* keys, const double* lo, const double* hi,
-                                                         std::size_t padded_count, double t) {
+__attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys, const double* lo, const double* hi,
+                                                               std::size_t padded_count, double t) {
   const Lanes threshold = Lanes{} + t;
   Lanes above{}, weighted{}, below{}, up = Lanes{} + kInfinity, down = Lanes{} - kInfinity;
   LaneMask position = {0, 1, 2, 3}, up_at = LaneMask{} - 1, down_at = LaneMask{} - 1;
@@ -69,7 +73,7 @@ __attribute__((always_inline)) inline PassSums pass_body(const double* keys, con
     const Lanes weight = select(over, low, high);
     above += weight;
     weighted += weight * key;
-    if (kKind != PassKind::Above) below += select(key < threshold, high, low);
+    below += select(key < threshold, high, low);
     if (kKind == PassKind::Neighbours) {
       const LaneMask under = key < threshold;
       const LaneMask slack = high > low;
@@ -80,39 +84,42 @@ __attribute__((always_inline)) inline PassSums pass_body(const double* keys, con
       down_at = select(nearer_down, position, down_at);
     }
   }
-  PassSums sums;
+  SumsOf<kKind> sums;
   for (std::size_t lane = 0; lane < kThresholdLanes; ++lane) {
     sums.above += above[lane];
     sums.weighted += weighted[lane];
     sums.below += below[lane];
-    if (kKind == PassKind::Neighbours && up[lane] < sums.up) {
-      sums.up = up[lane];
-      sums.up_position = std::size_t(up_at[lane]);
-    }
-    if (kKind == PassKind::Neighbours && down[lane] > sums.down) {
-      sums.down = down[lane];
-      sums.down_position = std::size_t(down_at[lane]);
+    if constexpr (kKind == PassKind::Neighbours) {
+      if (up[lane] < sums.up) {
+        sums.up = up[lane];
+        sums.up_position = std::size_t(up_at[lane]);
+      }
+      if (down[lane] > sums.down) {
+        sums.down = down[lane];
+        sums.down_position = std::size_t(down_at[lane]);
+      }
     }
   }
   return sums;
 }
 
 template <PassKind kKind>
-PassSums baseline_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count, double t) {
+SumsOf<kKind> baseline_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count,
+                            double t) {
   return pass_body<kKind>(keys, lo, hi, padded_count, t);
 }
 
 #ifdef AMYTISS_HAS_AVX2_PASS
 template <PassKind kKind>
-__attribute__((target("avx2,fma"))) PassSums avx2_pass(const double* keys, const double* lo, const double* hi,
-                                                       std::size_t padded_count, double t) {
+__attribute__((target("avx2,fma"))) SumsOf<kKind> avx2_pass(const double* keys, const double* lo, const double* hi,
+                                                            std::size_t padded_count, double t) {
   return pass_body<kKind>(keys, lo, hi, padded_count, t);
 }
 #endif
 
 template <PassKind kKind>
-PassSums cells_pass(VectorUnit unit, const double* keys, const double* lo, const double* hi, std::size_t padded_count,
-                    double t) {
+SumsOf<kKind> cells_pass(VectorUnit unit, const double* keys, const double* lo, const double* hi,
+                         std::size_t padded_count, double t) {
 #ifdef AMYTISS_HAS_AVX2_PASS
   if (unit == VectorUnit::Avx2) return avx2_pass<kKind>(keys, lo, hi, padded_count, t);
 #endif
@@ -120,48 +127,36 @@ PassSums cells_pass(VectorUnit unit, const double* keys, const double* lo, const
 }
 
 // Leave or cut, one outcome as the pass takes a cell.
-void add_outcome(PassSums& sums, double key, const MassInterval& mass, double t) {
+template <typename Sums>
+void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
   const double weight = key > t ? mass.lo : mass.hi;
   sums.above += weight;
   sums.weighted += weight * key;
   sums.below += key < t ? mass.hi : mass.lo;
-  if (mass.hi > mass.lo && key > t && key < sums.up) {
-    sums.up = key;
-    sums.up_position = kNoPosition;
-  }
-  if (mass.hi > mass.lo && key < t && key > sums.down) {
-    sums.down = key;
-    sums.down_position = kNoPosition;
+  if constexpr (std::is_same_v<Sums, ScanSums>) {
+    if (mass.hi > mass.lo && key > t && key < sums.up) {
+      sums.up = key;
+      sums.up_position = kNoPosition;
+    }
+    if (mass.hi > mass.lo && key < t && key > sums.down) {
+      sums.down = key;
+      sums.down_position = kNoPosition;
+    }
   }
 }
 
 // D(t) of a window over keys[window.first ..] (with leave and cut) less its error bound: at most
 // `outcomes` + 2 roundings of terms whose magnitudes sum to at most |t| + above * (1 + |t|), keys
-// lying in [-1, 1]. PassKind::Above: sums.below holds leave and cut alone.
+// lying in [-1, 1].
 template <PassKind kKind>
 double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
-                  PassSums& sums) {
+                  SumsOf<kKind>& sums) {
   sums = cells_pass<kKind>(unit, keys + window.first, window.lo, window.hi, window.padded_count(), t);
   add_outcome(sums, extra_keys[0], window.leave, t);
   add_outcome(sums, extra_keys[1], window.cut, t);
   const double error =
       robust_expectation_rounding(window.count + 2) * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));
   return t * (1.0 - sums.above) + sums.weighted - error;
-}
-
-// D's weights just below t, the key of rank `start`, from those just above it: `above` less the
-// slack of the window's outcomes whose key is t (a short run of equal keys).
-double weight_below(const SortedLine& line, const PackedWindow& window, const double* extra_keys, std::size_t start,
-                    double above) {
-  const double t = line.keys()[line.order(start)];
-  double slack = 0.0;
-  for (std::size_t r = line.run_first(start); r <= line.run_last(start); ++r) {
-    const std::size_t j = line.order(r) - window.first;  // wraps below the window
-    if (j < window.count) slack += window.hi[j] - window.lo[j];
-  }
-  if (extra_keys[0] == t) slack += window.leave.hi - window.leave.lo;
-  if (extra_keys[1] == t) slack += window.cut.hi - window.cut.lo;
-  return above - slack;
 }
 
 // The outcomes of one key next to t with slack: the window's cells of that key and leave or cut.
@@ -325,11 +320,7 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   const std::size_t outcomes = window.count + 2;
   PassSums sums;
   double t = line.keys()[line.order(start)];
-  // The pass leaves out D's weights below t where they are a short run's slack away; where t's
-  // run of equal keys is long (a plateau of values) it sums them too.
-  const bool long_runs = line.run_last(start) - line.run_first(start) >= kShortRun;
-  double best = long_runs ? sound_dual<PassKind::Below>(unit, line.keys(), window, extra_keys, t, sums)
-                          : sound_dual<PassKind::Above>(unit, line.keys(), window, extra_keys, t, sums);
+  double best = sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra_keys, t, sums);
   // D is linear between neighbouring keys with slack: with slope 1 - above above t, 1 - below
   // below it. Each step moves to the next such key, where D's slope is updated by the key's slack,
   // while D still rises. A step's own rounding: that of the sums behind the slope and of three
@@ -337,12 +328,8 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   // their roundings would add up: D is evaluated afresh where the search ends.
   constexpr std::size_t kStepsInOnePass = 2;
   const double step_rounding = robust_expectation_rounding(outcomes + 2);
-  int direction = 1;
-  double slope_weight = sums.above, dual = best;
-  if (!(sums.above < 1.0)) {
-    slope_weight = long_runs ? sums.below : weight_below(line, window, extra_keys, start, sums.above);
-    direction = slope_weight > 1.0 ? -1 : 0;
-  }
+  const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
+  double slope_weight = direction > 0 ? sums.above : sums.below, dual = best;
   std::size_t steps = 0;  // taken
   while (direction != 0 && steps < outcomes) {
     const Group next = next_group(line, window, extra_keys, t, start, direction);
@@ -356,7 +343,7 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
     if (direction > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
   }
   if (steps > kStepsInOnePass)
-    best = std::max(best, sound_dual<PassKind::Above>(unit, line.keys(), window, extra_keys, t, sums));
+    best = std::max(best, sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra_keys, t, sums));
   return std::clamp(sign * best, 0.0, 1.0);
 }
 
@@ -366,7 +353,7 @@ double threshold_scan(const double* keys, const PackedWindow& window, Bound boun
   const double extra_keys[2] = {0.0, sign * cut_value(bound)};  // leave, cut
   // Each pass finds D's value and slopes at t and the window's next keys with slack either side;
   // the search moves to the next key while D rises there, which is a fresh pass away.
-  PassSums sums;
+  ScanSums sums;
   double t = keys[start];
   double best = sound_dual<PassKind::Neighbours>(unit, keys, window, extra_keys, t, sums);
   const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;

@@ -9,7 +9,6 @@ namespace detail {
 
 Layout::Layout(const Abstraction& a) {
   const std::size_t dims = a.states.dims();
-  const auto& h = a.noise->window_half_cells();
   half.resize(dims);
   width.resize(dims);
   mass_offset.resize(dims);
