@@ -82,8 +82,8 @@ OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<st
     }
     cost.sizes.push_back(size);
     cost.multiply_adds += size * double(widths[dim]);
-    const bool weighted = !vector && layout == FactoredLayout::Kernels;
-    cost.weighted += size * double(widths[dim]) * (weighted ? kScalarStageWeight : 1.0);
+    const bool scalar_stage = !vector && layout == FactoredLayout::Kernels;
+    cost.weighted += size * double(widths[dim]) * (scalar_stage ? kScalarStageWeight : 1.0);
   }
   return cost;
 }

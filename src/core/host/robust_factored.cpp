@@ -248,7 +248,8 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
     LineCursor cursor(walk.carried);
     for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
       const std::size_t last = std::min(first + chunk, lines);
-      for (std::size_t index = (cursor.seek(first), first); index < last; ++index, cursor.next()) {
+      cursor.seek(first);
+      for (std::size_t index = first; index < last; ++index, cursor.next()) {
         const std::size_t base = cursor.input, output_base = cursor.output, tuple_base = cursor.tuple;
         const bool previous_line = index > first;
         for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
