@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "amytiss/format.hpp"
+#include "host/factored_layout.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -37,7 +38,8 @@ std::size_t window_width(const Abstraction& a, std::size_t dim) {
 
 // Entries of W_k for k = 1..d in the order (the sliced dimension, order.back(), at full size),
 // the multiply-adds of all stages, and the cost the order is chosen by: multiply-adds, a stage
-// without a vector digit (see build_stages) weighted by kScalarStageWeight in the kernels' layout.
+// without a vector digit (host/factored_layout.cpp) weighted by kScalarStageWeight in the kernels'
+// layout.
 struct OrderCost {
   std::vector<double> sizes;
   double multiply_adds = 0;
@@ -68,8 +70,8 @@ OrderCost order_cost(const std::vector<std::size_t>& order, const std::vector<st
         size *= double(counts[r]);
         ++posts_left;
       }
-    // Vector digits (see vector_digits): V's last dimension in the first stage; later, a remaining
-    // post cell or a variable the contracted coordinate does not read.
+    // Vector digits (host/factored_layout.cpp): V's last dimension in the first stage; later, a
+    // remaining post cell or a variable the contracted coordinate does not read.
     bool vector = false;
     if (k == 0) {
       vector = dims >= 2 && dim != dims - 1;
@@ -110,155 +112,6 @@ std::vector<std::size_t> greedy_order(const std::vector<std::vector<std::size_t>
     left.erase(left.begin() + std::ptrdiff_t(best));
   }
   return order;
-}
-
-std::vector<std::uint64_t> strides_of(const std::vector<TensorDigit>& layout) {
-  std::vector<std::uint64_t> strides(layout.size());
-  std::uint64_t stride = 1;
-  for (std::size_t j = layout.size(); j-- > 0;) {
-    strides[j] = stride;
-    stride *= layout[j].radix;
-  }
-  return strides;
-}
-
-std::uint64_t stride_in(const std::vector<TensorDigit>& layout, const std::vector<std::uint64_t>& strides,
-                        bool post, std::size_t id) {
-  for (std::size_t j = 0; j < layout.size(); ++j)
-    if (layout[j].post == post && layout[j].id == id) return strides[j];
-  return 0;
-}
-
-// The digit each stage computes eight (or four, two) entries at a time along: it must be in the
-// stage's input and output, read by no mass of the contracted coordinate (so that the entries
-// share their masses and window) and be the input's fastest digit (contiguous values). The first
-// stage reads V, whose fastest digit is the last post dimension; later inputs are laid out by the
-// stage before, which puts the next stage's vector digit last, so any remaining post cell or
-// unread variable qualifies: the one with the most values. nullopt: the stage runs scalar.
-struct DigitId {
-  bool post;
-  std::size_t id;
-};
-std::vector<std::optional<DigitId>> vector_digits(const std::vector<std::size_t>& order,
-                                                  const std::vector<std::vector<std::size_t>>& reads,
-                                                  const std::vector<FactorVariable>& variables,
-                                                  const std::vector<std::size_t>& counts, std::size_t slice_cells) {
-  const std::size_t dims = counts.size(), sliced = order.back();
-  std::vector<std::optional<DigitId>> digits(order.size());
-  std::vector<char> used(variables.size(), 0), remaining(dims, 1);
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const std::size_t dim = order[k];
-    remaining[dim] = 0;
-    auto radix_of_post = [&](std::size_t r) { return r == sliced ? slice_cells : counts[r]; };
-    std::size_t best_radix = 1;
-    if (k == 0) {
-      if (dims >= 2 && dim != dims - 1 && radix_of_post(dims - 1) >= 2) digits[k] = DigitId{true, dims - 1};
-    } else {
-      for (std::size_t r = 0; r < dims; ++r)
-        if (remaining[r] && radix_of_post(r) > best_radix) {
-          best_radix = radix_of_post(r);
-          digits[k] = DigitId{true, r};
-        }
-      for (std::size_t v = 0; v < variables.size(); ++v)
-        if (used[v] && std::find(reads[dim].begin(), reads[dim].end(), v) == reads[dim].end() &&
-            variables[v].count > best_radix) {
-          best_radix = variables[v].count;
-          digits[k] = DigitId{false, v};
-        }
-    }
-    for (std::size_t v : reads[dim]) used[v] = 1;
-  }
-  return digits;
-}
-
-// The final layout of stage k's output, from the input's digits and then the new variables.
-void arrange_output(std::vector<TensorDigit>& output, std::size_t k, const std::vector<std::size_t>& order,
-                    const std::vector<std::optional<DigitId>>& vectors, const std::vector<FactorVariable>& variables,
-                    FactoredLayout layout) {
-  // Q: input and disturbance digits last, so that the input choice reads each state's values
-  // from one stretch of memory.
-  if (k + 1 == order.size())
-    std::stable_partition(output.begin(), output.end(), [&](const TensorDigit& digit) {
-      return variables[digit.id].space == FactorVariable::Space::State;
-    });
-  if (layout == FactoredLayout::Lines) {
-    // The largest remaining post cell that the next stage does not contract goes last: the next
-    // stage's consecutive lines then differ in it alone (neighbouring cells of the value
-    // function: close values, the same windows) and lie side by side in memory.
-    auto last = output.end();
-    for (auto digit = output.begin(); k + 1 < order.size() && digit != output.end(); ++digit)
-      if (digit->post && digit->id != order[k + 1] && (last == output.end() || digit->radix > last->radix))
-        last = digit;
-    if (last != output.end()) std::rotate(last, last + 1, output.end());
-    return;
-  }
-  // The next stage's contracted cell goes just before its vector digit: each work-item's
-  // window is then one contiguous block of the next input.
-  if (k + 1 < order.size()) {
-    const auto next = std::find_if(output.begin(), output.end(), [&](const TensorDigit& digit) {
-      return digit.post && digit.id == order[k + 1];
-    });
-    std::rotate(next, next + 1, output.end());
-  }
-  if (k + 1 < order.size() && vectors[k + 1]) {
-    const auto next = std::find_if(output.begin(), output.end(), [&](const TensorDigit& digit) {
-      return digit.post == vectors[k + 1]->post && digit.id == vectors[k + 1]->id;
-    });
-    std::rotate(next, next + 1, output.end());
-  }
-}
-
-// Stages of an order for slices of `slice_cells` cells of the last dimension eliminated.
-std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
-                                        const std::vector<std::vector<std::size_t>>& reads,
-                                        const std::vector<FactorVariable>& variables,
-                                        const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths,
-                                        std::size_t slice_cells, FactoredLayout layout) {
-  const std::size_t dims = counts.size(), sliced = order.back();
-  std::vector<std::optional<DigitId>> vectors = vector_digits(order, reads, variables, counts, slice_cells);
-  if (layout == FactoredLayout::Lines) vectors.assign(order.size(), std::nullopt);
-  std::vector<TensorDigit> input;
-  for (std::size_t r = 0; r < dims; ++r) input.push_back({true, r, counts[r]});  // V, unsliced
-  std::vector<char> used(variables.size(), 0), remaining(dims, 1);
-  std::vector<FactoredStage> stages;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const std::size_t dim = order[k];
-    for (std::size_t v : reads[dim]) used[v] = 1;
-    remaining[dim] = 0;
-    FactoredStage stage;
-    stage.dimension = dim;
-    stage.width = widths[dim];
-    // The input's digits in the input's order (so that work-items stream the input), then the
-    // variables new to this stage (neighbouring work-items then differ in masses only and re-read
-    // the same window of values from cache).
-    for (const TensorDigit& digit : input)
-      if (!(digit.post && digit.id == dim))
-        stage.output.push_back({digit.post, digit.id, digit.post && digit.id == sliced ? slice_cells : digit.radix});
-    for (std::size_t v : reads[dim])
-      if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
-        stage.output.push_back({false, v, variables[v].count});
-    arrange_output(stage.output, k, order, vectors, variables, layout);
-    const std::vector<std::uint64_t> input_strides = strides_of(input);
-    std::vector<std::uint64_t> tuple_strides(variables.size(), 0);
-    std::uint64_t tuple_stride = 1;
-    for (std::size_t j = reads[dim].size(); j-- > 0;) {
-      tuple_strides[reads[dim][j]] = tuple_stride;
-      tuple_stride *= variables[reads[dim][j]].count;
-    }
-    stage.output_size = 1;
-    for (std::size_t j = 0; j < stage.output.size(); ++j) {
-      const TensorDigit& digit = stage.output[j];
-      stage.output_size *= digit.radix;
-      stage.input_stride.push_back(stride_in(input, input_strides, digit.post, digit.id));
-      stage.tuple_stride.push_back(digit.post ? 0 : tuple_strides[digit.id]);
-      if (vectors[k] && digit.post == vectors[k]->post && digit.id == vectors[k]->id) stage.vector_digit = j;
-    }
-    assert(!stage.vector_digit || (stage.input_stride[*stage.vector_digit] == 1 && stage.tuple_stride[*stage.vector_digit] == 0));
-    stage.contracted_stride = stride_in(input, input_strides, true, dim);
-    input = stage.output;
-    stages.push_back(std::move(stage));
-  }
-  return stages;
 }
 
 std::string variable_name(const FactorVariable& variable) {
