@@ -22,8 +22,13 @@ double ceil_to(double x, double quantum) {
 
 MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,
                            const Grid& disturbances) {
-  return [&enclosure, &states, &inputs, &disturbances](std::size_t cell, std::size_t input, std::size_t disturbance,
-                                                       double* lo, double* hi) {
+  // Rounded outward to a binary grid far finer than the cell: boxes equal in exact arithmetic (a
+  // linear map on the grid gives many cells one mean) are then equal bit for bit, and share one
+  // entry of bounds and one search per line of the variable elimination.
+  std::vector<double> quanta;
+  for (double width : states.eta()) quanta.push_back(binary_quantum(width));
+  return [&enclosure, &states, &inputs, &disturbances, quanta](std::size_t cell, std::size_t input,
+                                                               std::size_t disturbance, double* lo, double* hi) {
     const std::vector<double> centre = states.point(cell);
     IntervalBox box;
     for (std::size_t j = 0; j < centre.size(); ++j)
@@ -34,12 +39,8 @@ MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, 
     constexpr double kInfinity = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < image.box.size(); ++i) {
       const bool known = image.defined && !image.box[i].is_empty();
-      // Rounded outward to a binary grid far finer than the cell: boxes equal in exact arithmetic
-      // (a linear map on the grid gives many cells one mean) are then equal bit for bit, and share
-      // one entry of bounds and one search per line of the variable elimination.
-      const double quantum = binary_quantum(states.eta()[i]);
-      lo[i] = known ? floor_to(image.box[i].lo, quantum) : -kInfinity;
-      hi[i] = known ? ceil_to(image.box[i].hi, quantum) : kInfinity;
+      lo[i] = known ? floor_to(image.box[i].lo, quanta[i]) : -kInfinity;
+      hi[i] = known ? ceil_to(image.box[i].hi, quanta[i]) : kInfinity;
     }
   };
 }
