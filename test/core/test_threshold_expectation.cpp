@@ -1,6 +1,6 @@
 // The O-maximisation by its threshold (host/threshold_expectation.hpp): a sorted line holds an
-// increasing order (line after line, neighbours and lines drawn afresh), its runs of equal keys
-// and its windows' ranks; from any starting rank,
+// increasing order (line after line, neighbours and lines drawn afresh) and its windows' ranks;
+// from any starting rank,
 // on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
 // without slack, and leave or cut taking the whole budget, the search gives robust_expectation()'s
 // bound within rounding, never past the exact value's sound side, and ends on a rank of the line,
@@ -36,7 +36,7 @@ SortedLine sorted_line(const std::vector<double>& values, Bound bound) {
 
 // Sorted lines in a row: each a neighbour of the last (a few values moved a little), now and then
 // one drawn afresh.
-TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderItsRunsAndEachWindowsRanks) {
+TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderAndEachWindowsRanks) {
   std::mt19937 random(kSeed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (std::size_t length : kLengths) {
@@ -56,10 +56,6 @@ TEST(ThresholdExpectation, SortedLineHoldsAnIncreasingOrderItsRunsAndEachWindows
         ASSERT_EQ(line.rank(line.order(r)), r);
         const double key = line.keys()[line.order(r)];
         ASSERT_TRUE(r == 0 || line.keys()[line.order(r - 1)] <= key) << "length " << length << " trial " << trial;
-        ASSERT_EQ(line.keys()[line.order(line.run_first(r))], key);
-        ASSERT_EQ(line.keys()[line.order(line.run_last(r))], key);
-        ASSERT_TRUE(line.run_first(r) == 0 || line.keys()[line.order(line.run_first(r) - 1)] < key);
-        ASSERT_TRUE(line.run_last(r) + 1 == length || line.keys()[line.order(line.run_last(r) + 1)] > key);
       }
       if (length > SortedLine::kMaskedLength) continue;
       for (std::size_t first = 0; first < length; ++first)
@@ -127,6 +123,44 @@ TEST(ThresholdExpectation, TheScanFromAnyStartIsTheSortedOneWithinRoundingOnItsS
     for (std::size_t a = 0; a < values.size(); ++a) keys[a] = (bound == Bound::Lower ? 1.0 : -1.0) * values[a];
     return threshold_scan(keys.data(), window, bound, start, unit);
   });
+}
+
+// Many windows over one line in one batch (their first passes in one loop, then the searches that
+// move on): each search's bound and end as threshold_expectation() gives them alone, bit for bit.
+TEST(ThresholdExpectation, ABatchGivesEachSearchsBoundAndEndBitForBit) {
+  constexpr std::size_t kWindowsPerLine = 12;
+  std::mt19937 random(kSeed);
+  ThresholdSearches batch;
+  for (VectorUnit unit : vector_units())
+    for (std::size_t length : kLengths)
+      for (int trial = 0; trial < kTrials / 10; ++trial) {
+        const std::vector<double> values = trial % 2 ? random_line(random, length) : random_smooth_line(random, length);
+        std::vector<RandomRow> rows;
+        std::vector<DimensionView> views;
+        for (std::size_t w = 0; w < kWindowsPerLine; ++w) rows.push_back(random_row(random, length));
+        for (RandomRow& row : rows) {
+          row.window.cells = row.cells.data();
+          views.push_back(row.window);
+        }
+        const PackedWindows packed(views);
+        std::vector<const PackedWindow*> windows;
+        for (std::size_t w = 0; w < kWindowsPerLine; ++w) windows.push_back(&packed[w]);
+        std::uniform_int_distribution<std::uint32_t> any_position(0, std::uint32_t(length - 1));
+        for (Bound bound : {Bound::Lower, Bound::Upper}) {
+          const SortedLine line = sorted_line(values, bound);
+          std::vector<std::uint32_t> positions(kWindowsPerLine);
+          for (std::uint32_t& position : positions) position = any_position(random);
+          const std::vector<std::uint32_t> starts = positions;
+          std::vector<double> bounds(kWindowsPerLine);
+          batch.run(line, windows.data(), kWindowsPerLine, bound, positions.data(), bounds.data(), unit);
+          for (std::size_t w = 0; w < kWindowsPerLine; ++w) {
+            std::size_t end = line.rank(starts[w]);
+            EXPECT_EQ(bounds[w], threshold_expectation(line, packed[w], bound, end, unit))
+                << "length " << length << " trial " << trial << " window " << w;
+            EXPECT_EQ(positions[w], line.order(end)) << "length " << length << " trial " << trial << " window " << w;
+          }
+        }
+      }
 }
 
 TEST(ThresholdExpectation, EveryVectorUnitGivesTheBaselinesBoundUpToTheOrderOfAdditions) {

@@ -244,35 +244,35 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
     // neighbouring lines hold close values, and their i-th windows are one tuple or neighbouring
     // ones, so the threshold sits at the same cell or next to it.
     std::vector<std::uint32_t> ends(searches);
-    std::vector<double> results(shared ? searches : 0);
+    std::vector<const PackedWindow*> line_windows(searches);
+    std::vector<double> bounds(searches);
+    ThresholdSearches batch;
     LineCursor cursor(walk.carried);
     for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
       const std::size_t last = std::min(first + chunk, lines);
       cursor.seek(first);
       for (std::size_t index = first; index < last; ++index, cursor.next()) {
         const std::size_t base = cursor.input, output_base = cursor.output, tuple_base = cursor.tuple;
-        const bool previous_line = index > first;
+        const bool previous_line = index > first;  // a chunk's lines alone decide its results, bit for bit
         for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
-        if (sorted) line.sort(previous_line);  // a chunk's lines alone decide its results, bit for bit
-        // On a chunk's first line, each search starts where the previous window's ended.
-        std::size_t start = length / 2;  // a rank, or a position
-        for (std::size_t s = 0; s < searches; ++s) {
-          const std::size_t i = shared ? walk.searched[s] : s;
-          const PackedWindow& window = windows[window_of[tuple_base + walk.free_tuples[i]]];
-          double bound;
-          if (sorted) {
-            if (previous_line) start = line.rank(ends[s]);
-            bound = threshold_expectation(line, window, bound_, start, unit_);
-            ends[s] = std::uint32_t(line.order(start));
-          } else {
+        for (std::size_t s = 0; s < searches; ++s)
+          line_windows[s] = &windows[window_of[tuple_base + walk.free_tuples[shared ? walk.searched[s] : s]]];
+        if (sorted) {
+          line.sort(previous_line);
+          // A chunk's first line: every search from the median key.
+          if (!previous_line) std::fill(ends.begin(), ends.end(), std::uint32_t(line.order(length / 2)));
+          batch.run(line, line_windows.data(), searches, bound_, ends.data(), bounds.data(), unit_);
+        } else {
+          // A chunk's first line: each search from where the previous window's ended.
+          std::size_t start = length / 2;
+          for (std::size_t s = 0; s < searches; ++s) {
             if (previous_line) start = ends[s];
-            bound = threshold_scan(line.keys(), window, bound_, start, unit_);
+            bounds[s] = threshold_scan(line.keys(), *line_windows[s], bound_, start, unit_);
             ends[s] = std::uint32_t(start);
           }
-          (shared ? results[s] : out[output_base + walk.free_offsets[i]]) = bound;
         }
-        for (std::size_t i = 0; shared && i < applied; ++i)
-          out[output_base + walk.free_offsets[i]] = results[walk.search_of[i]];
+        for (std::size_t i = 0; i < applied; ++i)
+          out[output_base + walk.free_offsets[i]] = bounds[shared ? walk.search_of[i] : i];
       }
     }
   });

@@ -128,7 +128,7 @@ SumsOf<kKind> cells_pass(VectorUnit unit, const double* keys, const double* lo, 
 
 // Leave or cut, one outcome as the pass takes a cell.
 template <typename Sums>
-void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
+__attribute__((always_inline)) inline void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
   const double weight = key > t ? mass.lo : mass.hi;
   sums.above += weight;
   sums.weighted += weight * key;
@@ -145,18 +145,23 @@ void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
   }
 }
 
-// D(t) of a window over keys[window.first ..] (with leave and cut) less its error bound: at most
-// `outcomes` + 2 roundings of terms whose magnitudes sum to at most |t| + above * (1 + |t|), keys
-// lying in [-1, 1].
+// D(t) from a window's sums (with leave and cut) less its error bound: at most `outcomes` + 2
+// roundings of terms whose magnitudes sum to at most |t| + above * (1 + |t|), keys lying in [-1, 1].
+__attribute__((always_inline)) inline double dual_less_error(const PackedWindow& window, double t,
+                                                             const PassSums& sums) {
+  const double error =
+      robust_expectation_rounding(window.count + 2) * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));
+  return t * (1.0 - sums.above) + sums.weighted - error;
+}
+
+// D(t) of a window over keys[window.first ..] less its error bound.
 template <PassKind kKind>
 double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
                   SumsOf<kKind>& sums) {
   sums = cells_pass<kKind>(unit, keys + window.first, window.lo, window.hi, window.padded_count(), t);
   add_outcome(sums, extra_keys[0], window.leave, t);
   add_outcome(sums, extra_keys[1], window.cut, t);
-  const double error =
-      robust_expectation_rounding(window.count + 2) * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));
-  return t * (1.0 - sums.above) + sums.weighted - error;
+  return dual_less_error(window, t, sums);
 }
 
 // The outcomes of one key next to t with slack: the window's cells of that key and leave or cut.
@@ -201,20 +206,19 @@ Group next_group(const SortedLine& line, const PackedWindow& window, const doubl
                  std::size_t start, int direction) {
   Group group{direction * kInfinity, 0.0, start};
   auto beyond = [&](double a, double b) { return direction > 0 ? a > b : a < b; };
-  const bool at_t = line.keys()[line.order(start)] == t;
-  const std::size_t from = direction > 0 ? (at_t ? line.run_last(start) : start) + 1
-                                         : (at_t ? line.run_first(start) : start);
-  window_ranks(line, window, from, direction, [&](std::size_t q) {
+  // Keys equal to t on the way are passed over. Equal keys hold neighbouring ranks: past the group's
+  // cell, the search goes on only while the next rank's key is the group's.
+  window_ranks(line, window, direction > 0 ? start + 1 : start, direction, [&](std::size_t q) {
     const double key = line.keys()[line.order(q)];
     if (beyond(key, group.key)) return false;
     const std::size_t j = line.order(q) - window.first;
     const double slack = window.hi[j] - window.lo[j];
-    if (slack > 0.0 && beyond(key, t)) {
-      group.key = key;
-      group.slack += slack;
-      group.rank = q;
-    }
-    return true;
+    if (!(slack > 0.0 && beyond(key, t))) return true;
+    group.key = key;
+    group.slack += slack;
+    group.rank = q;
+    const std::size_t next = q + direction;  // wraps below 0
+    return next < line.length() && line.keys()[line.order(next)] == key;
   });
   const MassInterval extras[2] = {window.leave, window.cut};
   for (std::size_t e = 0; e < 2; ++e) {
@@ -253,9 +257,7 @@ SortedLine::SortedLine(std::size_t length)
     : length_(length),
       keys_(length + kThresholdLanes, 0.0),
       order_(length),
-      rank_(length),
-      run_first_(length),
-      run_last_(length) {
+      rank_(length) {
   if (length <= kMaskedLength) rank_bits_.assign((length + 1) * 2, 0);
 }
 
@@ -281,16 +283,16 @@ void SortedLine::sort(bool from_last) {
   else
     sort_line(keys_.data(), length_, Bound::Lower, order_.data(), rank_.data());
   sorted_before_ = true;
-  for (std::size_t r = 0; r < length_; ++r)
-    run_first_[r] = r > 0 && keys_[order_[r]] == keys_[order_[r - 1]] ? run_first_[r - 1] : std::uint32_t(r);
-  for (std::size_t r = length_; r-- > 0;)
-    run_last_[r] = r + 1 < length_ && keys_[order_[r]] == keys_[order_[r + 1]] ? run_last_[r + 1] : std::uint32_t(r);
   if (rank_bits_.empty()) return;
   // Ranks are distinct: the bits of positions first .. last - 1 are prefix(last) minus prefix(first).
+  std::uint64_t low = 0, high = 0;  // in registers: not a chain of stores and loads
   for (std::size_t position = 0; position < length_; ++position) {
     const std::size_t r = rank_[position];
-    rank_bits_[(position + 1) * 2] = rank_bits_[position * 2] | (r < 64 ? std::uint64_t(1) << r : 0);
-    rank_bits_[(position + 1) * 2 + 1] = rank_bits_[position * 2 + 1] | (r < 64 ? 0 : std::uint64_t(1) << (r - 64));
+    const std::uint64_t bit = std::uint64_t(1) << (r % 64), in_high = -std::uint64_t(r >= 64);
+    low |= bit & ~in_high;
+    high |= bit & in_high;
+    rank_bits_[(position + 1) * 2] = low;
+    rank_bits_[(position + 1) * 2 + 1] = high;
   }
 }
 
@@ -313,14 +315,87 @@ std::vector<VectorUnit> vector_units() {
   return units;
 }
 
-double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
-                             VectorUnit unit) {
-  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
-  const double extra_keys[2] = {0.0, sign * cut_value(bound)};  // leave, cut
+namespace {
+
+// The keys of leave and cut for a bound.
+struct ExtraKeys {
+  explicit ExtraKeys(Bound bound) : keys{0.0, (bound == Bound::Lower ? 1.0 : -1.0) * cut_value(bound)} {}
+  double keys[2];
+};
+
+using Opened = ThresholdSearches::Opened;
+
+// A search's first pass, at the key of `position`; inlined into one function per instruction set,
+// which the batch's loop and the single search share (the same roundings).
+__attribute__((always_inline)) inline Opened open_body(const double* keys, const PackedWindow& window,
+                                                       const double* extra_keys, std::size_t position) {
+  const double t = keys[position];
+  PassSums sums = pass_body<PassKind::Slopes>(keys + window.first, window.lo, window.hi, window.padded_count(), t);
+  add_outcome(sums, extra_keys[0], window.leave, t);
+  add_outcome(sums, extra_keys[1], window.cut, t);
+  return {t, dual_less_error(window, t, sums), sums.above, sums.below};
+}
+
+// Every search's first pass; the searches that move on (their indices, in order) and their count.
+// No branch on a search's outcome.
+__attribute__((always_inline)) inline std::size_t open_all_body(const double* keys, const PackedWindow* const* windows,
+                                                                std::size_t count, const double* extra_keys,
+                                                                const std::uint32_t* positions, Opened* opened,
+                                                                std::uint32_t* moving) {
+  std::size_t moving_count = 0;
+  for (std::size_t s = 0; s < count; ++s) {
+    opened[s] = open_body(keys, *windows[s], extra_keys, positions[s]);
+    moving[moving_count] = std::uint32_t(s);
+    moving_count += opened[s].direction() != 0;
+  }
+  return moving_count;
+}
+
+Opened baseline_open(const double* keys, const PackedWindow& window, const double* extra_keys, std::size_t position) {
+  return open_body(keys, window, extra_keys, position);
+}
+
+std::size_t baseline_open_all(const double* keys, const PackedWindow* const* windows, std::size_t count,
+                              const double* extra_keys, const std::uint32_t* positions, Opened* opened,
+                              std::uint32_t* moving) {
+  return open_all_body(keys, windows, count, extra_keys, positions, opened, moving);
+}
+
+#ifdef AMYTISS_HAS_AVX2_PASS
+__attribute__((target("avx2,fma"))) Opened avx2_open(const double* keys, const PackedWindow& window,
+                                                     const double* extra_keys, std::size_t position) {
+  return open_body(keys, window, extra_keys, position);
+}
+
+__attribute__((target("avx2,fma"))) std::size_t avx2_open_all(const double* keys, const PackedWindow* const* windows,
+                                                              std::size_t count, const double* extra_keys,
+                                                              const std::uint32_t* positions, Opened* opened,
+                                                              std::uint32_t* moving) {
+  return open_all_body(keys, windows, count, extra_keys, positions, opened, moving);
+}
+#endif
+
+Opened open_search(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, std::size_t start,
+                   VectorUnit unit) {
+#ifdef AMYTISS_HAS_AVX2_PASS
+  if (unit == VectorUnit::Avx2) return avx2_open(line.keys(), window, extra.keys, line.order(start));
+#endif
+  return baseline_open(line.keys(), window, extra.keys, line.order(start));
+}
+
+std::size_t open_searches(const SortedLine& line, const PackedWindow* const* windows, std::size_t count,
+                          const ExtraKeys& extra, const std::uint32_t* positions, Opened* opened,
+                          std::uint32_t* moving, VectorUnit unit) {
+#ifdef AMYTISS_HAS_AVX2_PASS
+  if (unit == VectorUnit::Avx2) return avx2_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
+#endif
+  return baseline_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
+}
+
+// The search from its first threshold on, in keys (the bound's sign applied).
+double step_search(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, Opened opened,
+                   std::size_t& start, VectorUnit unit) {
   const std::size_t outcomes = window.count + 2;
-  PassSums sums;
-  double t = line.keys()[line.order(start)];
-  double best = sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra_keys, t, sums);
   // D is linear between neighbouring keys with slack: with slope 1 - above above t, 1 - below
   // below it. Each step moves to the next such key, where D's slope is updated by the key's slack,
   // while D still rises. A step's own rounding: that of the sums behind the slope and of three
@@ -328,11 +403,12 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
   // their roundings would add up: D is evaluated afresh where the search ends.
   constexpr std::size_t kStepsInOnePass = 2;
   const double step_rounding = robust_expectation_rounding(outcomes + 2);
-  const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
-  double slope_weight = direction > 0 ? sums.above : sums.below, dual = best;
+  const int direction = opened.direction();
+  double t = opened.t, best = opened.best, dual = best;
+  double slope_weight = direction > 0 ? opened.above : opened.below;
   std::size_t steps = 0;  // taken
   while (direction != 0 && steps < outcomes) {
-    const Group next = next_group(line, window, extra_keys, t, start, direction);
+    const Group next = next_group(line, window, extra.keys, t, start, direction);
     if (std::abs(next.key) == kInfinity) break;
     dual += (next.key - t) * (1.0 - slope_weight) - step_rounding * (1.0 + slope_weight);
     best = std::max(best, dual);
@@ -342,9 +418,39 @@ double threshold_expectation(const SortedLine& line, const PackedWindow& window,
     ++steps;
     if (direction > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
   }
-  if (steps > kStepsInOnePass)
-    best = std::max(best, sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra_keys, t, sums));
-  return std::clamp(sign * best, 0.0, 1.0);
+  if (steps > kStepsInOnePass) {
+    PassSums sums;
+    best = std::max(best, sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra.keys, t, sums));
+  }
+  return best;
+}
+
+double bound_of_keys(double best, Bound bound) { return std::clamp((bound == Bound::Lower ? 1.0 : -1.0) * best, 0.0, 1.0); }
+
+}  // namespace
+
+double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
+                             VectorUnit unit) {
+  const ExtraKeys extra(bound);
+  return bound_of_keys(step_search(line, window, extra, open_search(line, window, extra, start, unit), start, unit),
+                       bound);
+}
+
+void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* windows, std::size_t count, Bound bound,
+                            std::uint32_t* positions, double* bounds, VectorUnit unit) {
+  const ExtraKeys extra(bound);
+  opened_.resize(count);
+  pending_.resize(count);
+  // Every search's first pass, in one loop without a branch on its outcome: the passes of
+  // neighbouring searches are independent and overlap. Most searches end there.
+  const std::size_t moving = open_searches(line, windows, count, extra, positions, opened_.data(), pending_.data(), unit);
+  for (std::size_t s = 0; s < count; ++s) bounds[s] = bound_of_keys(opened_[s].best, bound);
+  for (std::size_t m = 0; m < moving; ++m) {
+    const std::size_t s = pending_[m];
+    std::size_t start = line.rank(positions[s]);
+    bounds[s] = bound_of_keys(step_search(line, *windows[s], extra, opened_[s], start, unit), bound);
+    positions[s] = std::uint32_t(line.order(start));
+  }
 }
 
 double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,

@@ -49,9 +49,9 @@ class PackedWindows {
 };
 
 /// One line of keys (value for Bound::Lower, -value for Bound::Upper; values in [0, 1]) as the
-/// search reads it: the keys, padded with kThresholdLanes zeros; their increasing order;
-/// each rank's run of equal keys; and, for lines up to kMaskedLength long, the ranks of the
-/// positions before each position as bits, so that a window's ranks are two lookups.
+/// search reads it: the keys, padded with kThresholdLanes zeros; their increasing order; and, for
+/// lines up to kMaskedLength long, the ranks of the positions before each position as bits, so
+/// that a window's ranks are two lookups.
 class SortedLine {
  public:
   static constexpr std::size_t kMaskedLength = 128;
@@ -66,9 +66,6 @@ class SortedLine {
   /// The position of rank r, the rank of a position.
   std::size_t order(std::size_t r) const { return order_[r]; }
   std::size_t rank(std::size_t position) const { return rank_[position]; }
-  /// The first and last rank of r's run of equal keys.
-  std::size_t run_first(std::size_t r) const { return run_first_[r]; }
-  std::size_t run_last(std::size_t r) const { return run_last_[r]; }
   /// Lines up to kMaskedLength long: the ranks of positions first .. first + count - 1 as bits of
   /// two words.
   void ranks_of(std::size_t first, std::size_t count, std::uint64_t* mask) const;
@@ -77,7 +74,7 @@ class SortedLine {
   std::size_t length_;
   bool sorted_before_ = false;
   std::vector<double> keys_;
-  std::vector<std::uint32_t> order_, rank_, run_first_, run_last_;
+  std::vector<std::uint32_t> order_, rank_;
   std::vector<std::uint64_t> rank_bits_;  // [position * 2 + word]: ranks of positions before it
 };
 
@@ -93,6 +90,28 @@ std::vector<VectorUnit> vector_units();
 /// vector_units(); every unit gives the same bound up to the order of additions.
 double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
                              VectorUnit unit);
+
+/// threshold_expectation() of many windows over one line, the same bounds bit for bit: every search
+/// first evaluates D where it starts, all in one loop (independent passes overlap), and those
+/// that must move then step on. Holds its working storage (one object per thread).
+class ThresholdSearches {
+ public:
+  /// A search after its first pass: the threshold t (a key), D(t) less its error bound, and the
+  /// weights of D's slope just above and just below t.
+  struct Opened {
+    double t, best, above, below;
+    /// Where D still rises: +1 above t, -1 below, 0 neither (t is the maximiser).
+    int direction() const { return above < 1.0 ? 1 : below > 1.0 ? -1 : 0; }
+  };
+  /// `windows[0..count)`; `positions[i]`: the position (not the rank) of the cell whose key search i
+  /// starts from, on return where it ended; `bounds[i]`: its bound.
+  void run(const SortedLine& line, const PackedWindow* const* windows, std::size_t count, Bound bound,
+           std::uint32_t* positions, double* bounds, VectorUnit unit);
+
+ private:
+  std::vector<Opened> opened_;
+  std::vector<std::uint32_t> pending_;
+};
 
 /// The same bound without a sorted line, for lines that few windows read (a sort would cost more
 /// than it saves): each step is a pass over the window. `keys`: the line's keys (as SortedLine
