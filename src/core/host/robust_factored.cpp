@@ -245,6 +245,7 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
     // ones, so the threshold sits at the same cell or next to it.
     std::vector<std::uint32_t> ends(searches);
     std::vector<const PackedWindow*> line_windows(searches);
+    std::size_t windows_tuple_base = ~std::size_t(0);  // whose windows line_windows holds
     std::vector<double> bounds(searches);
     ThresholdSearches batch;
     LineCursor cursor(walk.carried);
@@ -255,8 +256,10 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
         const std::size_t base = cursor.input, output_base = cursor.output, tuple_base = cursor.tuple;
         const bool previous_line = index > first;  // a chunk's lines alone decide its results, bit for bit
         for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
-        for (std::size_t s = 0; s < searches; ++s)
-          line_windows[s] = &windows[window_of[tuple_base + walk.free_tuples[shared ? walk.searched[s] : s]]];
+        if (tuple_base != windows_tuple_base)  // consecutive lines mostly read the same windows
+          for (std::size_t s = 0; s < searches; ++s)
+            line_windows[s] = &windows[window_of[tuple_base + walk.free_tuples[shared ? walk.searched[s] : s]]];
+        windows_tuple_base = tuple_base;
         if (sorted) {
           line.sort(previous_line);
           // A chunk's first line: every search from the median key.

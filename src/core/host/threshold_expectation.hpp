@@ -21,12 +21,14 @@ namespace amytiss::detail {
 constexpr std::size_t kThresholdLanes = 4;
 
 /// A window as the search reads it: cells first .. first + count - 1 of the line, their lower and
-/// upper bounds in two arrays of padded_count() entries (zeros past count), then leave and cut.
+/// upper bounds in two arrays of padded_count() entries (zeros past count), then leave and cut,
+/// and the relative rounding of a sum over its count + 2 outcomes (robust_expectation_rounding()).
 struct PackedWindow {
-  std::size_t first = 0, count = 0;
+  std::uint32_t first = 0, count = 0;
   const double* lo = nullptr;
   const double* hi = nullptr;
   MassInterval leave, cut;
+  double rounding = 0.0;
   std::size_t padded_count() const { return padded(count); }
   static std::size_t padded(std::size_t count) {
     return (count + kThresholdLanes - 1) / kThresholdLanes * kThresholdLanes;
