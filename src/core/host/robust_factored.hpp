@@ -8,9 +8,9 @@
 // cut worth cut_value(bound), and Q = W_d holds every (cell, input, disturbance)'s bound. Each line
 // of W_{k-1} is read once and every tuple applied to it by a threshold search; tuples that read
 // the same window (a linear map on the grid gives many cells one mean) share one search. A line
-// that feeds many searches is sorted first (threshold_expectation()), one that feeds few is not
-// (threshold_scan()); each search starts where the search of the window in the same place ended
-// on the line before. The tensors are laid out for this (FactoredLayout::Lines): a line's results
+// that feeds many searches is sorted first and searched in one batch (ThresholdSearches), one that
+// feeds few is not (threshold_scan()); each search starts where the search of the window in the
+// same place ended on the line before. The tensors are laid out for this (FactoredLayout::Lines): a line's results
 // are written side by side.
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
@@ -39,7 +39,7 @@ class RobustFactoredSweep {
   /// At most this many bytes for the tensors, Q and the mass tables (half of it for one tensor).
   static constexpr double kMaxBytes = 2.0 * (1 << 30);
   /// How a stage searches its lines. Auto: stages whose lines feed at least kSearchesWorthASort
-  /// searches sort each line (threshold_expectation()), the others search unsorted lines
+  /// searches sort each line (ThresholdSearches), the others search unsorted lines
   /// (threshold_scan()); Sorted and Scan: every stage so (the same bounds up to rounding).
   enum class LineSearch { Auto, Sorted, Scan };
   static constexpr std::size_t kSearchesWorthASort = 16;

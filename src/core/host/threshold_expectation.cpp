@@ -178,19 +178,18 @@ struct Group {
   std::size_t rank;  // the last of the group's cells met in the line's order (the start if none)
 };
 
-// Calls visit(rank) for the window's ranks from `from` on in `direction` (+1: from and up; -1:
-// below from, down) until it returns false.
-template <typename Visit>
-void window_ranks(const SortedLine& line, const PackedWindow& window, std::size_t from, int direction,
-                  Visit&& visit) {
+// Calls visit(rank) for the window's ranks from `from` on in direction kDirection (+1: from and up;
+// -1: below from, down) until it returns false.
+template <int kDirection, typename Visit>
+void window_ranks(const SortedLine& line, const PackedWindow& window, std::size_t from, Visit&& visit) {
   if (line.length() > SortedLine::kMaskedLength) {
-    for (std::size_t q = direction > 0 ? from : from - 1; q < line.length(); q += direction)  // wraps below 0
+    for (std::size_t q = kDirection > 0 ? from : from - 1; q < line.length(); q += kDirection)  // wraps below 0
       if (line.order(q) - window.first < window.count && !visit(q)) return;
     return;
   }
   std::uint64_t mask[2];
   line.ranks_of(window.first, window.count, mask);
-  if (direction > 0) {
+  if constexpr (kDirection > 0) {
     for (std::size_t word = from / 64; word < 2; ++word) {
       std::uint64_t bits = mask[word] & (word == from / 64 ? ~std::uint64_t(0) << (from % 64) : ~std::uint64_t(0));
       for (; bits; bits &= bits - 1)
@@ -206,16 +205,17 @@ void window_ranks(const SortedLine& line, const PackedWindow& window, std::size_
   }
 }
 
-// The window's next key past t in `direction` (+1 up, -1 down) among its outcomes with slack,
-// from rank `start` (whose key is t, or, after leave or cut, lies before t); key +-infinity
-// where there is none.
+// The window's next key past t in direction kDirection (+1 up, -1 down) among its outcomes with
+// slack, from rank `start` (whose key is t, or, after leave or cut, lies before t); key
+// +-infinity where there is none.
+template <int kDirection>
 Group next_group(const SortedLine& line, const PackedWindow& window, const double* extra_keys, double t,
-                 std::size_t start, int direction) {
-  Group group{direction * kInfinity, 0.0, start};
-  auto beyond = [&](double a, double b) { return direction > 0 ? a > b : a < b; };
+                 std::size_t start) {
+  Group group{kDirection * kInfinity, 0.0, start};
+  auto beyond = [](double a, double b) { return kDirection > 0 ? a > b : a < b; };
   // Keys equal to t on the way are passed over. Equal keys hold neighbouring ranks: past the group's
   // cell, the search goes on only while the next rank's key is the group's.
-  window_ranks(line, window, direction > 0 ? start + 1 : start, direction, [&](std::size_t q) {
+  window_ranks<kDirection>(line, window, kDirection > 0 ? start + 1 : start, [&](std::size_t q) {
     const double key = line.keys()[line.order(q)];
     if (beyond(key, group.key)) return false;
     const std::size_t j = line.order(q) - window.first;
@@ -224,7 +224,7 @@ Group next_group(const SortedLine& line, const PackedWindow& window, const doubl
     group.key = key;
     group.slack += slack;
     group.rank = q;
-    const std::size_t next = q + direction;  // wraps below 0
+    const std::size_t next = q + kDirection;  // wraps below 0
     return next < line.length() && line.keys()[line.order(next)] == key;
   });
   const MassInterval extras[2] = {window.leave, window.cut};
@@ -343,26 +343,34 @@ __attribute__((always_inline)) inline Opened open_body(const double* keys, const
   return {t, dual_less_error(window, t, sums), sums.above, sums.below};
 }
 
-// Every search's first pass; the searches that move on (their indices, in order) and their count.
-// No branch on a search's outcome.
-__attribute__((always_inline)) inline std::size_t open_all_body(const double* keys, const PackedWindow* const* windows,
+// The searches that move on after their first pass: up (ranks rising) and down.
+struct Moving {
+  std::size_t up = 0, down = 0;
+};
+
+// Every search's first pass, and the searches that move on: those that move up at the front of
+// `moving` and those that move down at its back, each in order. No branch on a search's outcome.
+__attribute__((always_inline)) inline Moving open_all_body(const double* keys, const PackedWindow* const* windows,
                                                                 std::size_t count, const double* extra_keys,
                                                                 const std::uint32_t* positions, Opened* opened,
                                                                 std::uint32_t* moving) {
-  std::size_t moving_count = 0;
+  Moving counts;
   for (std::size_t s = 0; s < count; ++s) {
     opened[s] = open_body(keys, *windows[s], extra_keys, positions[s]);
-    moving[moving_count] = std::uint32_t(s);
-    moving_count += opened[s].direction() != 0;
+    const int direction = opened[s].direction();
+    moving[counts.up] = std::uint32_t(s);
+    moving[count - 1 - counts.down] = std::uint32_t(s);  // the same slot only when both hold s
+    counts.up += direction > 0;
+    counts.down += direction < 0;
   }
-  return moving_count;
+  return counts;
 }
 
 Opened baseline_open(const double* keys, const PackedWindow& window, const double* extra_keys, std::size_t position) {
   return open_body(keys, window, extra_keys, position);
 }
 
-std::size_t baseline_open_all(const double* keys, const PackedWindow* const* windows, std::size_t count,
+Moving baseline_open_all(const double* keys, const PackedWindow* const* windows, std::size_t count,
                               const double* extra_keys, const std::uint32_t* positions, Opened* opened,
                               std::uint32_t* moving) {
   return open_all_body(keys, windows, count, extra_keys, positions, opened, moving);
@@ -374,7 +382,7 @@ __attribute__((target("avx2,fma"))) Opened avx2_open(const double* keys, const P
   return open_body(keys, window, extra_keys, position);
 }
 
-__attribute__((target("avx2,fma"))) std::size_t avx2_open_all(const double* keys, const PackedWindow* const* windows,
+__attribute__((target("avx2,fma"))) Moving avx2_open_all(const double* keys, const PackedWindow* const* windows,
                                                               std::size_t count, const double* extra_keys,
                                                               const std::uint32_t* positions, Opened* opened,
                                                               std::uint32_t* moving) {
@@ -390,7 +398,7 @@ Opened open_search(const SortedLine& line, const PackedWindow& window, const Ext
   return baseline_open(line.keys(), window, extra.keys, line.order(start));
 }
 
-std::size_t open_searches(const SortedLine& line, const PackedWindow* const* windows, std::size_t count,
+Moving open_searches(const SortedLine& line, const PackedWindow* const* windows, std::size_t count,
                           const ExtraKeys& extra, const std::uint32_t* positions, Opened* opened,
                           std::uint32_t* moving, VectorUnit unit) {
 #ifdef AMYTISS_HAS_AVX2_PASS
@@ -399,9 +407,10 @@ std::size_t open_searches(const SortedLine& line, const PackedWindow* const* win
   return baseline_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
 }
 
-// The search from its first threshold on, in keys (the bound's sign applied).
-double step_search(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, Opened opened,
-                   std::size_t& start, VectorUnit unit) {
+// The search from its first threshold on in direction kDirection, in keys (the bound's sign applied).
+template <int kDirection>
+double steps_from(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, Opened opened,
+                  std::size_t& start, VectorUnit unit) {
   const std::size_t outcomes = window.count + 2;
   // D is linear between neighbouring keys with slack: with slope 1 - above above t, 1 - below
   // below it. Each step moves to the next such key, where D's slope is updated by the key's slack,
@@ -410,26 +419,33 @@ double step_search(const SortedLine& line, const PackedWindow& window, const Ext
   // their roundings would add up: D is evaluated afresh where the search ends.
   constexpr std::size_t kStepsInOnePass = 2;
   const double step_rounding = robust_expectation_rounding(outcomes + 2);
-  const int direction = opened.direction();
   double t = opened.t, best = opened.best, dual = best;
-  double slope_weight = direction > 0 ? opened.above : opened.below;
+  double slope_weight = kDirection > 0 ? opened.above : opened.below;
   std::size_t steps = 0;  // taken
-  while (direction != 0 && steps < outcomes) {
-    const Group next = next_group(line, window, extra.keys, t, start, direction);
+  while (steps < outcomes) {
+    const Group next = next_group<kDirection>(line, window, extra.keys, t, start);
     if (std::abs(next.key) == kInfinity) break;
     dual += (next.key - t) * (1.0 - slope_weight) - step_rounding * (1.0 + slope_weight);
     best = std::max(best, dual);
     t = next.key;
     start = next.rank;
-    slope_weight += direction * next.slack;
+    slope_weight += kDirection * next.slack;
     ++steps;
-    if (direction > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
+    if (kDirection > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
   }
   if (steps > kStepsInOnePass) {
     PassSums sums;
     best = std::max(best, sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra.keys, t, sums));
   }
   return best;
+}
+
+double step_search(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, Opened opened,
+                   std::size_t& start, VectorUnit unit) {
+  const int direction = opened.direction();
+  if (direction > 0) return steps_from<1>(line, window, extra, opened, start, unit);
+  if (direction < 0) return steps_from<-1>(line, window, extra, opened, start, unit);
+  return opened.best;
 }
 
 double bound_of_keys(double best, Bound bound) { return std::clamp((bound == Bound::Lower ? 1.0 : -1.0) * best, 0.0, 1.0); }
@@ -450,14 +466,20 @@ void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* w
   pending_.resize(count);
   // Every search's first pass, in one loop without a branch on its outcome: the passes of
   // neighbouring searches are independent and overlap. Most searches end there.
-  const std::size_t moving = open_searches(line, windows, count, extra, positions, opened_.data(), pending_.data(), unit);
+  const Moving moving = open_searches(line, windows, count, extra, positions, opened_.data(), pending_.data(), unit);
   for (std::size_t s = 0; s < count; ++s) bounds[s] = bound_of_keys(opened_[s].best, bound);
-  for (std::size_t m = 0; m < moving; ++m) {
-    const std::size_t s = pending_[m];
-    std::size_t start = line.rank(positions[s]);
-    bounds[s] = bound_of_keys(step_search(line, *windows[s], extra, opened_[s], start, unit), bound);
-    positions[s] = std::uint32_t(line.order(start));
-  }
+  // Then the searches that move on, up first, then down: one direction at a time.
+  auto move_on = [&](auto steps, const std::uint32_t* searches, std::size_t searches_count) {
+    for (std::size_t m = 0; m < searches_count; ++m) {
+      const std::size_t s = searches[m];
+      std::size_t start = line.rank(positions[s]);
+      bounds[s] = bound_of_keys(steps(line, *windows[s], extra, opened_[s], start, unit), bound);
+      positions[s] = std::uint32_t(line.order(start));
+    }
+  };
+  move_on(steps_from<1>, pending_.data(), moving.up);
+  std::reverse(pending_.end() - moving.down, pending_.end());
+  move_on(steps_from<-1>, pending_.data() + count - moving.down, moving.down);
 }
 
 double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,
