@@ -249,8 +249,8 @@ PackedWindows::PackedWindows(const std::vector<DimensionView>& windows) {
   hi_.assign(total, 0.0);
   std::size_t offset = 0;
   for (const DimensionView& window : windows) {
-    PackedWindow packed{std::uint32_t(window.first), std::uint32_t(window.count), lo_.data() + offset, hi_.data() + offset,
-                        window.leave, window.cut, robust_expectation_rounding(window.count + 2)};
+    PackedWindow packed{std::uint32_t(window.first), std::uint32_t(window.count), lo_.data() + offset,
+                        hi_.data() + offset, window.leave, window.cut, robust_expectation_rounding(window.count + 2)};
     for (std::size_t j = 0; j < window.count; ++j) {
       lo_[offset + j] = window.cells[j].lo;
       hi_[offset + j] = window.cells[j].hi;
@@ -402,7 +402,8 @@ Moving open_searches(const SortedLine& line, const PackedWindow* const* windows,
                           const ExtraKeys& extra, const std::uint32_t* positions, Opened* opened,
                           std::uint32_t* moving, VectorUnit unit) {
 #ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2) return avx2_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
+  if (unit == VectorUnit::Avx2)
+    return avx2_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
 #endif
   return baseline_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
 }
@@ -448,7 +449,9 @@ double step_search(const SortedLine& line, const PackedWindow& window, const Ext
   return opened.best;
 }
 
-double bound_of_keys(double best, Bound bound) { return std::clamp((bound == Bound::Lower ? 1.0 : -1.0) * best, 0.0, 1.0); }
+double bound_of_keys(double best, Bound bound) {
+  return std::clamp((bound == Bound::Lower ? 1.0 : -1.0) * best, 0.0, 1.0);
+}
 
 }  // namespace
 
