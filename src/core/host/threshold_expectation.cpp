@@ -66,7 +66,8 @@ using SumsOf = std::conditional_t<kKind == PassKind::Neighbours, ScanSums, PassS
 // The pass's body, inlined into one function per instruction set.
 template <PassKind kKind>
 __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys, const double* lo, const double* hi,
-                                                               std::size_t padded_count, double t) {
+                                                               std::size_t padded_count, double t,
+                                                               const double* outcome_keys = nullptr) {
   const Lanes threshold = Lanes{} + t;
   Lanes above{}, weighted{}, below{}, up = Lanes{} + kInfinity, down = Lanes{} - kInfinity;
   LaneMask position = {0, 1, 2, 3}, up_at = LaneMask{} - 1, down_at = LaneMask{} - 1;
@@ -81,7 +82,7 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
     above += weight;
     weighted += weight * key;
     below += select(key < threshold, high, low);
-    if (kKind == PassKind::Neighbours) {
+    if constexpr (kKind == PassKind::Neighbours) {
       const LaneMask under = key < threshold;
       const LaneMask slack = high > low;
       const LaneMask nearer_up = over & slack & (key < up), nearer_down = under & slack & (key > down);
@@ -90,6 +91,16 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
       down = select(nearer_down, key, down);
       down_at = select(nearer_down, position, down_at);
     }
+  }
+  if (outcome_keys) {  // leave and cut as one more block: the window's after its padded cells
+    Lanes key, low, high;
+    std::memcpy(&key, outcome_keys, sizeof key);
+    std::memcpy(&low, lo + padded_count, sizeof low);
+    std::memcpy(&high, hi + padded_count, sizeof high);
+    const Lanes weight = select(key > threshold, low, high);
+    above += weight;
+    weighted += weight * key;
+    below += select(key < threshold, high, low);
   }
   SumsOf<kKind> sums;
   sums.above = lane_sum(above);
@@ -243,7 +254,7 @@ PackedWindows::PackedWindows(const std::vector<DimensionView>& windows) {
   std::size_t total = 0;
   for (const DimensionView& window : windows) {
     window_sums(window);  // a feasible row, or std::logic_error
-    total += PackedWindow::padded(window.count);
+    total += PackedWindow::padded(window.count) + kThresholdLanes;
   }
   lo_.assign(total, 0.0);
   hi_.assign(total, 0.0);
@@ -256,6 +267,12 @@ PackedWindows::PackedWindows(const std::vector<DimensionView>& windows) {
       hi_[offset + j] = window.cells[j].hi;
     }
     offset += packed.padded_count();
+    const MassInterval outcomes[2] = {window.leave, window.cut};
+    for (std::size_t e = 0; e < 2; ++e) {
+      lo_[offset + e] = outcomes[e].lo;
+      hi_[offset + e] = outcomes[e].hi;
+    }
+    offset += kThresholdLanes;
     views_.push_back(packed);
   }
 }
@@ -326,8 +343,8 @@ namespace {
 
 // The keys of leave and cut for a bound.
 struct ExtraKeys {
-  explicit ExtraKeys(Bound bound) : keys{0.0, (bound == Bound::Lower ? 1.0 : -1.0) * cut_value(bound)} {}
-  double keys[2];
+  explicit ExtraKeys(Bound bound) : keys{0.0, (bound == Bound::Lower ? 1.0 : -1.0) * cut_value(bound), 0.0, 0.0} {}
+  double keys[kThresholdLanes];  // leave, cut, then zeros: the lanes of the window's outcome block
 };
 
 using Opened = ThresholdSearches::Opened;
@@ -337,9 +354,8 @@ using Opened = ThresholdSearches::Opened;
 __attribute__((always_inline)) inline Opened open_body(const double* keys, const PackedWindow& window,
                                                        const double* extra_keys, std::size_t position) {
   const double t = keys[position];
-  PassSums sums = pass_body<PassKind::Slopes>(keys + window.first, window.lo, window.hi, window.padded_count(), t);
-  add_outcome(sums, extra_keys[0], window.leave, t);
-  add_outcome(sums, extra_keys[1], window.cut, t);
+  const PassSums sums =
+      pass_body<PassKind::Slopes>(keys + window.first, window.lo, window.hi, window.padded_count(), t, extra_keys);
   return {t, dual_less_error(window, t, sums), sums.above, sums.below};
 }
 

@@ -21,8 +21,9 @@ namespace amytiss::detail {
 constexpr std::size_t kThresholdLanes = 4;
 
 /// A window as the search reads it: cells first .. first + count - 1 of the line, their lower and
-/// upper bounds in two arrays of padded_count() entries (zeros past count), then leave and cut,
-/// and the relative rounding of a sum over its count + 2 outcomes (robust_expectation_rounding()).
+/// upper bounds in two arrays of padded_count() entries (zeros past count) followed by a block of
+/// kThresholdLanes entries (leave, cut, zeros), then leave and cut, and the relative rounding of a
+/// sum over its count + 2 outcomes (robust_expectation_rounding()).
 struct PackedWindow {
   std::uint32_t first = 0, count = 0;
   const double* lo = nullptr;
