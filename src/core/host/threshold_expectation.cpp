@@ -2,185 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
-#include <type_traits>
 
 #include "host/ordered_expectation.hpp"
-
-// The pass is the hot loop of the variable elimination: built for AVX2 with FMA as well as for the
-// baseline instruction set.
-#if defined(__x86_64__) && defined(__GNUC__)
-#define AMYTISS_HAS_AVX2_PASS 1
-#endif
-#pragma GCC diagnostic ignored "-Wpsabi"
+#include "host/threshold_pass.hpp"
 
 namespace amytiss::detail {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr std::size_t kNoPosition = ~std::size_t(0);
-
-typedef double Lanes __attribute__((vector_size(kThresholdLanes * sizeof(double))));
-typedef long LaneMask __attribute__((vector_size(kThresholdLanes * sizeof(double))));
-
-// mask ? a : b lane by lane, in bit operations: GCC turns a vector ?: into scalar code. Always
-// inlined into the passes, so the baseline's ABI for vector arguments never applies (the -Wpsabi
-// note, which GCC gives at the end of the file, is switched off above).
-__attribute__((always_inline)) inline Lanes select(LaneMask mask, Lanes a, Lanes b) {
-  return reinterpret_cast<Lanes>((mask & reinterpret_cast<LaneMask>(a)) | (~mask & reinterpret_cast<LaneMask>(b)));
-}
-
-__attribute__((always_inline)) inline LaneMask select(LaneMask mask, LaneMask a, LaneMask b) {
-  return (mask & a) | (~mask & b);
-}
-
-// The sum of the lanes, pairwise (halves, then their two lanes: few instructions, short latency).
-__attribute__((always_inline)) inline double lane_sum(Lanes lanes) {
-  typedef double Pair __attribute__((vector_size(2 * sizeof(double))));
-  const Pair halves = Pair{lanes[0], lanes[1]} + Pair{lanes[2], lanes[3]};
-  return halves[0] + halves[1];
-}
-
-// D at threshold t over a window, D(t) = t (1 - above) + weighted, and the weights of its slope
-// on either side of t.
-struct PassSums {
-  double above = 0.0;     // sum of (key > t ? lo : hi): 1 - D's slope just above t; D's weights
-  double weighted = 0.0;  // sum of key * (key > t ? lo : hi)
-  double below = 0.0;     // sum of (key < t ? hi : lo): 1 - D's slope just below t
-};
-// And the nearest keys with slack above and below t (+-infinity: none), with the position of one
-// cell of each in the window (kNoPosition: none, or leave or cut). Apart: the sorted search's
-// passes return the smaller struct.
-struct ScanSums : PassSums {
-  double up = kInfinity, down = -kInfinity;
-  std::size_t up_position = kNoPosition, down_position = kNoPosition;
-};
-
-// What a pass computes: D's value and the weights of its slope either side of t, and with them
-// the neighbouring keys.
-enum class PassKind { Slopes, Neighbours };
-template <PassKind kKind>
-using SumsOf = std::conditional_t<kKind == PassKind::Neighbours, ScanSums, PassSums>;
-
-// The pass's body, inlined into one function per instruction set.
-template <PassKind kKind>
-__attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys, const double* lo, const double* hi,
-                                                               std::size_t padded_count, double t,
-                                                               const double* outcome_keys = nullptr) {
-  const Lanes threshold = Lanes{} + t;
-  Lanes above{}, weighted{}, below{}, up = Lanes{} + kInfinity, down = Lanes{} - kInfinity;
-  LaneMask position = {0, 1, 2, 3}, up_at = LaneMask{} - 1, down_at = LaneMask{} - 1;
-  static_assert(kThresholdLanes == 4, "one position per lane");
-  for (std::size_t j = 0; j < padded_count; j += kThresholdLanes, position += long(kThresholdLanes)) {
-    Lanes key, low, high;
-    std::memcpy(&key, keys + j, sizeof key);
-    std::memcpy(&low, lo + j, sizeof low);
-    std::memcpy(&high, hi + j, sizeof high);
-    const LaneMask over = key > threshold;
-    const Lanes weight = select(over, low, high);
-    above += weight;
-    weighted += weight * key;
-    below += select(key < threshold, high, low);
-    if constexpr (kKind == PassKind::Neighbours) {
-      const LaneMask under = key < threshold;
-      const LaneMask slack = high > low;
-      const LaneMask nearer_up = over & slack & (key < up), nearer_down = under & slack & (key > down);
-      up = select(nearer_up, key, up);
-      up_at = select(nearer_up, position, up_at);
-      down = select(nearer_down, key, down);
-      down_at = select(nearer_down, position, down_at);
-    }
-  }
-  if (outcome_keys) {  // leave and cut as one more block: the window's after its padded cells
-    Lanes key, low, high;
-    std::memcpy(&key, outcome_keys, sizeof key);
-    std::memcpy(&low, lo + padded_count, sizeof low);
-    std::memcpy(&high, hi + padded_count, sizeof high);
-    const Lanes weight = select(key > threshold, low, high);
-    above += weight;
-    weighted += weight * key;
-    below += select(key < threshold, high, low);
-  }
-  SumsOf<kKind> sums;
-  sums.above = lane_sum(above);
-  sums.weighted = lane_sum(weighted);
-  sums.below = lane_sum(below);
-  for (std::size_t lane = 0; lane < kThresholdLanes; ++lane) {
-    if constexpr (kKind == PassKind::Neighbours) {
-      if (up[lane] < sums.up) {
-        sums.up = up[lane];
-        sums.up_position = std::size_t(up_at[lane]);
-      }
-      if (down[lane] > sums.down) {
-        sums.down = down[lane];
-        sums.down_position = std::size_t(down_at[lane]);
-      }
-    }
-  }
-  return sums;
-}
-
-template <PassKind kKind>
-SumsOf<kKind> baseline_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count,
-                            double t) {
-  return pass_body<kKind>(keys, lo, hi, padded_count, t);
-}
-
-#ifdef AMYTISS_HAS_AVX2_PASS
-template <PassKind kKind>
-__attribute__((target("avx2,fma"))) SumsOf<kKind> avx2_pass(const double* keys, const double* lo, const double* hi,
-                                                            std::size_t padded_count, double t) {
-  return pass_body<kKind>(keys, lo, hi, padded_count, t);
-}
-#endif
-
-template <PassKind kKind>
-SumsOf<kKind> cells_pass(VectorUnit unit, const double* keys, const double* lo, const double* hi,
-                         std::size_t padded_count, double t) {
-#ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2) return avx2_pass<kKind>(keys, lo, hi, padded_count, t);
-#endif
-  return baseline_pass<kKind>(keys, lo, hi, padded_count, t);
-}
-
-// Leave or cut, one outcome as the pass takes a cell.
-template <typename Sums>
-__attribute__((always_inline)) inline void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
-  const double weight = key > t ? mass.lo : mass.hi;
-  sums.above += weight;
-  sums.weighted += weight * key;
-  sums.below += key < t ? mass.hi : mass.lo;
-  if constexpr (std::is_same_v<Sums, ScanSums>) {
-    if (mass.hi > mass.lo && key > t && key < sums.up) {
-      sums.up = key;
-      sums.up_position = kNoPosition;
-    }
-    if (mass.hi > mass.lo && key < t && key > sums.down) {
-      sums.down = key;
-      sums.down_position = kNoPosition;
-    }
-  }
-}
-
-// D(t) from a window's sums (with leave and cut) less its error bound: at most `outcomes` + 2
-// roundings of terms whose magnitudes sum to at most |t| + above * (1 + |t|), keys lying in [-1, 1].
-__attribute__((always_inline)) inline double dual_less_error(const PackedWindow& window, double t,
-                                                             const PassSums& sums) {
-  const double error =
-      window.rounding * (1.0 + std::abs(t) + sums.above * (1.0 + std::abs(t)));
-  return t * (1.0 - sums.above) + sums.weighted - error;
-}
-
-// D(t) of a window over keys[window.first ..] less its error bound.
-template <PassKind kKind>
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
-                  SumsOf<kKind>& sums) {
-  sums = cells_pass<kKind>(unit, keys + window.first, window.lo, window.hi, window.padded_count(), t);
-  add_outcome(sums, extra_keys[0], window.leave, t);
-  add_outcome(sums, extra_keys[1], window.cut, t);
-  return dual_less_error(window, t, sums);
-}
+constexpr std::size_t kNoPosition = ScanSums::kNoPosition;
 
 // The outcomes of one key next to t with slack: the window's cells of that key and leave or cut.
 struct Group {
@@ -325,104 +156,9 @@ void SortedLine::ranks_of(std::size_t first, std::size_t count, std::uint64_t* m
     mask[word] = rank_bits_[(first + count) * 2 + word] & ~rank_bits_[first * 2 + word];
 }
 
-VectorUnit widest_vector_unit() {
-#ifdef AMYTISS_HAS_AVX2_PASS
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return VectorUnit::Avx2;
-#endif
-  return VectorUnit::Baseline;
-}
-
-std::vector<VectorUnit> vector_units() {
-  std::vector<VectorUnit> units{VectorUnit::Baseline};
-  if (widest_vector_unit() == VectorUnit::Avx2) units.push_back(VectorUnit::Avx2);
-  return units;
-}
-
 namespace {
 
-// The keys of leave and cut for a bound.
-struct ExtraKeys {
-  explicit ExtraKeys(Bound bound) : keys{0.0, (bound == Bound::Lower ? 1.0 : -1.0) * cut_value(bound), 0.0, 0.0} {}
-  double keys[kThresholdLanes];  // leave, cut, then zeros: the lanes of the window's outcome block
-};
-
 using Opened = ThresholdSearches::Opened;
-
-// A search's first pass, at the key of `position`; inlined into one function per instruction set,
-// which the batch's loop and the single search share (the same roundings).
-__attribute__((always_inline)) inline Opened open_body(const double* keys, const PackedWindow& window,
-                                                       const double* extra_keys, std::size_t position) {
-  const double t = keys[position];
-  const PassSums sums =
-      pass_body<PassKind::Slopes>(keys + window.first, window.lo, window.hi, window.padded_count(), t, extra_keys);
-  return {t, dual_less_error(window, t, sums), sums.above, sums.below};
-}
-
-// The searches that move on after their first pass: up (ranks rising) and down.
-struct Moving {
-  std::size_t up = 0, down = 0;
-};
-
-// Every search's first pass, and the searches that move on: those that move up at the front of
-// `moving` and those that move down at its back, each in order. No branch on a search's outcome.
-__attribute__((always_inline)) inline Moving open_all_body(const double* keys, const PackedWindow* const* windows,
-                                                                std::size_t count, const double* extra_keys,
-                                                                const std::uint32_t* positions, Opened* opened,
-                                                                std::uint32_t* moving) {
-  Moving counts;
-  for (std::size_t s = 0; s < count; ++s) {
-    opened[s] = open_body(keys, *windows[s], extra_keys, positions[s]);
-    const int direction = opened[s].direction();
-    moving[counts.up] = std::uint32_t(s);
-    moving[count - 1 - counts.down] = std::uint32_t(s);  // the same slot only when both hold s
-    counts.up += direction > 0;
-    counts.down += direction < 0;
-  }
-  return counts;
-}
-
-Opened baseline_open(const double* keys, const PackedWindow& window, const double* extra_keys, std::size_t position) {
-  return open_body(keys, window, extra_keys, position);
-}
-
-Moving baseline_open_all(const double* keys, const PackedWindow* const* windows, std::size_t count,
-                              const double* extra_keys, const std::uint32_t* positions, Opened* opened,
-                              std::uint32_t* moving) {
-  return open_all_body(keys, windows, count, extra_keys, positions, opened, moving);
-}
-
-#ifdef AMYTISS_HAS_AVX2_PASS
-__attribute__((target("avx2,fma"))) Opened avx2_open(const double* keys, const PackedWindow& window,
-                                                     const double* extra_keys, std::size_t position) {
-  return open_body(keys, window, extra_keys, position);
-}
-
-__attribute__((target("avx2,fma"))) Moving avx2_open_all(const double* keys, const PackedWindow* const* windows,
-                                                              std::size_t count, const double* extra_keys,
-                                                              const std::uint32_t* positions, Opened* opened,
-                                                              std::uint32_t* moving) {
-  return open_all_body(keys, windows, count, extra_keys, positions, opened, moving);
-}
-#endif
-
-Opened open_search(const SortedLine& line, const PackedWindow& window, const ExtraKeys& extra, std::size_t start,
-                   VectorUnit unit) {
-#ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2) return avx2_open(line.keys(), window, extra.keys, line.order(start));
-#endif
-  return baseline_open(line.keys(), window, extra.keys, line.order(start));
-}
-
-Moving open_searches(const SortedLine& line, const PackedWindow* const* windows, std::size_t count,
-                          const ExtraKeys& extra, const std::uint32_t* positions, Opened* opened,
-                          std::uint32_t* moving, VectorUnit unit) {
-#ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2)
-    return avx2_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
-#endif
-  return baseline_open_all(line.keys(), windows, count, extra.keys, positions, opened, moving);
-}
 
 // The search from its first threshold on in direction kDirection, in keys (the bound's sign applied).
 template <int kDirection>
@@ -452,7 +188,7 @@ double steps_from(const SortedLine& line, const PackedWindow& window, const Extr
   }
   if (steps > kStepsInOnePass) {
     PassSums sums;
-    best = std::max(best, sound_dual<PassKind::Slopes>(unit, line.keys(), window, extra.keys, t, sums));
+    best = std::max(best, sound_dual(unit, line.keys(), window, extra.keys, t, sums));
   }
   return best;
 }
@@ -474,8 +210,8 @@ double bound_of_keys(double best, Bound bound) {
 double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
                              VectorUnit unit) {
   const ExtraKeys extra(bound);
-  return bound_of_keys(step_search(line, window, extra, open_search(line, window, extra, start, unit), start, unit),
-                       bound);
+  const Opened opened = open_search(unit, line.keys(), window, extra, line.order(start));
+  return bound_of_keys(step_search(line, window, extra, opened, start, unit), bound);
 }
 
 void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* windows, std::size_t count, Bound bound,
@@ -485,7 +221,8 @@ void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* w
   pending_.resize(count);
   // Every search's first pass, in one loop without a branch on its outcome: the passes of
   // neighbouring searches are independent and overlap. Most searches end there.
-  const Moving moving = open_searches(line, windows, count, extra, positions, opened_.data(), pending_.data(), unit);
+  const Moving moving =
+      open_searches(unit, line.keys(), windows, count, extra, positions, opened_.data(), pending_.data());
   for (std::size_t s = 0; s < count; ++s) bounds[s] = bound_of_keys(opened_[s].best, bound);
   // Then the searches that move on, up first, then down: one direction at a time.
   auto move_on = [&](auto steps, const std::uint32_t* searches, std::size_t searches_count) {
@@ -504,12 +241,13 @@ void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* w
 double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,
                       VectorUnit unit) {
   const double sign = bound == Bound::Lower ? 1.0 : -1.0;
-  const double extra_keys[2] = {0.0, sign * cut_value(bound)};  // leave, cut
+  const ExtraKeys extra(bound);
+  const double* extra_keys = extra.keys;
   // Each pass finds D's value and slopes at t and the window's next keys with slack either side;
   // the search moves to the next key while D rises there, which is a fresh pass away.
   ScanSums sums;
   double t = keys[start];
-  double best = sound_dual<PassKind::Neighbours>(unit, keys, window, extra_keys, t, sums);
+  double best = sound_dual(unit, keys, window, extra_keys, t, sums);
   const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
   for (std::size_t steps = 0; direction != 0 && steps < window.count + 2; ++steps) {
     const double next = direction > 0 ? sums.up : sums.down;
@@ -517,7 +255,7 @@ double threshold_scan(const double* keys, const PackedWindow& window, Bound boun
     if (std::abs(next) == kInfinity) break;
     t = next;
     if (position != kNoPosition) start = window.first + position;
-    best = std::max(best, sound_dual<PassKind::Neighbours>(unit, keys, window, extra_keys, t, sums));
+    best = std::max(best, sound_dual(unit, keys, window, extra_keys, t, sums));
     if (direction > 0 ? sums.above >= 1.0 : sums.below <= 1.0) break;
   }
   return std::clamp(sign * best, 0.0, 1.0);
