@@ -186,10 +186,7 @@ double steps_from(const SortedLine& line, const PackedWindow& window, const Extr
     ++steps;
     if (kDirection > 0 ? slope_weight >= 1.0 : slope_weight <= 1.0) break;
   }
-  if (steps > kStepsInOnePass) {
-    PassSums sums;
-    best = std::max(best, sound_dual(unit, line.keys(), window, extra.keys, t, sums));
-  }
+  if (steps > kStepsInOnePass) best = std::max(best, open_search(unit, line.keys(), window, extra, t).best);
   return best;
 }
 
@@ -210,7 +207,7 @@ double bound_of_keys(double best, Bound bound) {
 double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
                              VectorUnit unit) {
   const ExtraKeys extra(bound);
-  const Opened opened = open_search(unit, line.keys(), window, extra, line.order(start));
+  const Opened opened = open_search(unit, line.keys(), window, extra, line.keys()[line.order(start)]);
   return bound_of_keys(step_search(line, window, extra, opened, start, unit), bound);
 }
 
@@ -240,7 +237,6 @@ void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* w
 
 double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,
                       VectorUnit unit) {
-  const double sign = bound == Bound::Lower ? 1.0 : -1.0;
   const ExtraKeys extra(bound);
   const double* extra_keys = extra.keys;
   // Each pass finds D's value and slopes at t and the window's next keys with slack either side;
@@ -248,7 +244,7 @@ double threshold_scan(const double* keys, const PackedWindow& window, Bound boun
   ScanSums sums;
   double t = keys[start];
   double best = sound_dual(unit, keys, window, extra_keys, t, sums);
-  const int direction = sums.above < 1.0 ? 1 : sums.below > 1.0 ? -1 : 0;
+  const int direction = rising_direction(sums.above, sums.below);
   for (std::size_t steps = 0; direction != 0 && steps < window.count + 2; ++steps) {
     const double next = direction > 0 ? sums.up : sums.down;
     const std::size_t position = direction > 0 ? sums.up_position : sums.down_position;
@@ -258,7 +254,7 @@ double threshold_scan(const double* keys, const PackedWindow& window, Bound boun
     best = std::max(best, sound_dual(unit, keys, window, extra_keys, t, sums));
     if (direction > 0 ? sums.above >= 1.0 : sums.below <= 1.0) break;
   }
-  return std::clamp(sign * best, 0.0, 1.0);
+  return bound_of_keys(best, bound);
 }
 
 }  // namespace amytiss::detail

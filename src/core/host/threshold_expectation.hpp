@@ -94,6 +94,10 @@ std::vector<VectorUnit> vector_units();
 double threshold_expectation(const SortedLine& line, const PackedWindow& window, Bound bound, std::size_t& start,
                              VectorUnit unit);
 
+/// Where D still rises from a threshold whose slope weights are `above` (just above it) and `below`
+/// (just below): +1 above, -1 below, 0 neither (the threshold is the maximiser).
+inline int rising_direction(double above, double below) { return above < 1.0 ? 1 : below > 1.0 ? -1 : 0; }
+
 /// threshold_expectation() of many windows over one line, the same bounds bit for bit: every search
 /// first evaluates D where it starts, all in one loop (independent passes overlap), and those
 /// that must move then step on. Holds its working storage (one object per thread).
@@ -103,8 +107,7 @@ class ThresholdSearches {
   /// weights of D's slope just above and just below t.
   struct Opened {
     double t, best, above, below;
-    /// Where D still rises: +1 above t, -1 below, 0 neither (t is the maximiser).
-    int direction() const { return above < 1.0 ? 1 : below > 1.0 ? -1 : 0; }
+    int direction() const { return rising_direction(above, below); }
   };
   /// `windows[0..count)`; `positions[i]`: the position (not the rank) of the cell whose key search i
   /// starts from, on return where it ended; `bounds[i]`: its bound.

@@ -102,45 +102,32 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
   return sums;
 }
 
-template <PassKind kKind>
-SumsOf<kKind> baseline_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count,
+// The unsorted search's pass over a window's cells, one function per instruction set.
+ScanSums baseline_scan_pass(const double* keys, const double* lo, const double* hi, std::size_t padded_count,
                             double t) {
-  return pass_body<kKind>(keys, lo, hi, padded_count, t);
+  return pass_body<PassKind::Neighbours>(keys, lo, hi, padded_count, t);
 }
 
 #ifdef AMYTISS_HAS_AVX2_PASS
-template <PassKind kKind>
-__attribute__((target("avx2,fma"))) SumsOf<kKind> avx2_pass(const double* keys, const double* lo, const double* hi,
+__attribute__((target("avx2,fma"))) ScanSums avx2_scan_pass(const double* keys, const double* lo, const double* hi,
                                                             std::size_t padded_count, double t) {
-  return pass_body<kKind>(keys, lo, hi, padded_count, t);
+  return pass_body<PassKind::Neighbours>(keys, lo, hi, padded_count, t);
 }
 #endif
 
-template <PassKind kKind>
-SumsOf<kKind> cells_pass(VectorUnit unit, const double* keys, const double* lo, const double* hi,
-                         std::size_t padded_count, double t) {
-#ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2) return avx2_pass<kKind>(keys, lo, hi, padded_count, t);
-#endif
-  return baseline_pass<kKind>(keys, lo, hi, padded_count, t);
-}
-
-// Leave or cut, one outcome as the pass takes a cell.
-template <typename Sums>
-__attribute__((always_inline)) inline void add_outcome(Sums& sums, double key, const MassInterval& mass, double t) {
+// Leave or cut, one outcome as the unsorted search's pass takes a cell.
+void add_outcome(ScanSums& sums, double key, const MassInterval& mass, double t) {
   const double weight = key > t ? mass.lo : mass.hi;
   sums.above += weight;
   sums.weighted += weight * key;
   sums.below += key < t ? mass.hi : mass.lo;
-  if constexpr (std::is_same_v<Sums, ScanSums>) {
-    if (mass.hi > mass.lo && key > t && key < sums.up) {
-      sums.up = key;
-      sums.up_position = kNoPosition;
-    }
-    if (mass.hi > mass.lo && key < t && key > sums.down) {
-      sums.down = key;
-      sums.down_position = kNoPosition;
-    }
+  if (mass.hi > mass.lo && key > t && key < sums.up) {
+    sums.up = key;
+    sums.up_position = kNoPosition;
+  }
+  if (mass.hi > mass.lo && key < t && key > sums.down) {
+    sums.down = key;
+    sums.down_position = kNoPosition;
   }
 }
 
@@ -152,37 +139,30 @@ __attribute__((always_inline)) inline double dual_less_error(const PackedWindow&
   return t * (1.0 - sums.above) + sums.weighted - error;
 }
 
-// D(t) of a window over keys[window.first ..] less its error bound.
-template <PassKind kKind>
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
-                  SumsOf<kKind>& sums) {
-  sums = cells_pass<kKind>(unit, keys + window.first, window.lo, window.hi, window.padded_count(), t);
-  add_outcome(sums, extra_keys[0], window.leave, t);
-  add_outcome(sums, extra_keys[1], window.cut, t);
-  return dual_less_error(window, t, sums);
-}
-
 }  // namespace
 
 double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
-                  PassSums& sums) {
-  return sound_dual<PassKind::Slopes>(unit, keys, window, extra_keys, t, sums);
-}
-
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
                   ScanSums& sums) {
-  return sound_dual<PassKind::Neighbours>(unit, keys, window, extra_keys, t, sums);
+  const double* cells = keys + window.first;
+#ifdef AMYTISS_HAS_AVX2_PASS
+  if (unit == VectorUnit::Avx2)
+    sums = avx2_scan_pass(cells, window.lo, window.hi, window.padded_count(), t);
+  else
+#endif
+    sums = baseline_scan_pass(cells, window.lo, window.hi, window.padded_count(), t);
+  add_outcome(sums, extra_keys[0], window.leave, t);
+  add_outcome(sums, extra_keys[1], window.cut, t);
+  return dual_less_error(window, t, sums);
 }
 
 namespace {
 
 using Opened = ThresholdSearches::Opened;
 
-// A search's first pass, at the key of `position`; inlined into one function per instruction set,
-// which the batch's loop and the single search share (the same roundings).
+// A search's pass at threshold t; inlined into one function per instruction set, which the batch's
+// loop and the single search share (the same roundings).
 __attribute__((always_inline)) inline Opened open_body(const double* keys, const PackedWindow& window,
-                                                       const double* extra_keys, std::size_t position) {
-  const double t = keys[position];
+                                                       const double* extra_keys, double t) {
   const PassSums sums =
       pass_body<PassKind::Slopes>(keys + window.first, window.lo, window.hi, window.padded_count(), t, extra_keys);
   return {t, dual_less_error(window, t, sums), sums.above, sums.below};
@@ -196,7 +176,7 @@ __attribute__((always_inline)) inline Moving open_all_body(const double* keys, c
                                                            std::uint32_t* moving) {
   Moving counts;
   for (std::size_t s = 0; s < count; ++s) {
-    opened[s] = open_body(keys, *windows[s], extra_keys, positions[s]);
+    opened[s] = open_body(keys, *windows[s], extra_keys, keys[positions[s]]);
     const int direction = opened[s].direction();
     moving[counts.up] = std::uint32_t(s);
     moving[count - 1 - counts.down] = std::uint32_t(s);  // the same slot only when both hold s
@@ -206,8 +186,8 @@ __attribute__((always_inline)) inline Moving open_all_body(const double* keys, c
   return counts;
 }
 
-Opened baseline_open(const double* keys, const PackedWindow& window, const double* extra_keys, std::size_t position) {
-  return open_body(keys, window, extra_keys, position);
+Opened baseline_open(const double* keys, const PackedWindow& window, const double* extra_keys, double t) {
+  return open_body(keys, window, extra_keys, t);
 }
 
 Moving baseline_open_all(const double* keys, const PackedWindow* const* windows, std::size_t count,
@@ -218,8 +198,8 @@ Moving baseline_open_all(const double* keys, const PackedWindow* const* windows,
 
 #ifdef AMYTISS_HAS_AVX2_PASS
 __attribute__((target("avx2,fma"))) Opened avx2_open(const double* keys, const PackedWindow& window,
-                                                     const double* extra_keys, std::size_t position) {
-  return open_body(keys, window, extra_keys, position);
+                                                     const double* extra_keys, double t) {
+  return open_body(keys, window, extra_keys, t);
 }
 
 __attribute__((target("avx2,fma"))) Moving avx2_open_all(const double* keys, const PackedWindow* const* windows,
@@ -233,11 +213,11 @@ __attribute__((target("avx2,fma"))) Moving avx2_open_all(const double* keys, con
 }  // namespace
 
 ThresholdSearches::Opened open_search(VectorUnit unit, const double* keys, const PackedWindow& window,
-                                      const ExtraKeys& extra, std::size_t position) {
+                                      const ExtraKeys& extra, double t) {
 #ifdef AMYTISS_HAS_AVX2_PASS
-  if (unit == VectorUnit::Avx2) return avx2_open(keys, window, extra.keys, position);
+  if (unit == VectorUnit::Avx2) return avx2_open(keys, window, extra.keys, t);
 #endif
-  return baseline_open(keys, window, extra.keys, position);
+  return baseline_open(keys, window, extra.keys, t);
 }
 
 Moving open_searches(VectorUnit unit, const double* keys, const PackedWindow* const* windows, std::size_t count,

@@ -35,15 +35,13 @@ struct ExtraKeys {
 };
 
 /// D(t) of a window over keys[window.first ..] (with leave and cut, keys extra_keys[0..1]) less its
-/// error bound, and the sums behind it: the slopes' weights, or also the nearest keys.
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
-                  PassSums& sums);
+/// error bound, with the sums behind it and the nearest keys (the unsorted search's pass).
 double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
                   ScanSums& sums);
 
-/// A search's first pass, at the key of position `position` of the line `keys`.
+/// A sorted search's pass at threshold t (a key of the line `keys`, or of leave or cut).
 ThresholdSearches::Opened open_search(VectorUnit unit, const double* keys, const PackedWindow& window,
-                                      const ExtraKeys& extra, std::size_t position);
+                                      const ExtraKeys& extra, double t);
 
 /// The searches that move on after their first pass: up (ranks rising) and down.
 struct Moving {
