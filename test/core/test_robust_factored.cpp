@@ -1,6 +1,7 @@
 // The product bound by variable elimination (host/robust_factored.hpp): every (cell, input,
 // disturbance) gets product_expectation_in_order() of its row in the plan's order, within rounding,
-// with sorted lines and with unsorted ones, and with tuples that share a window sharing a search;
+// with sorted lines and with unsorted ones, with tuples that share a window sharing a search, and
+// with a pair of stages run at once (a run of one stage's lines giving whole lines of the next);
 // the same bits on any number of workers;
 // that oracle is product_expectation() in the order (d-1, ..., 0) and lies within the joint
 // interval MDP's bounds in every order; the step takes this way where the sweep over whole tables
@@ -182,6 +183,9 @@ TEST(RobustFactored, TuplesThatShareAWindowShareASearch) {
   constexpr std::size_t kMeans = 2 * 16 + 16 + 1, kSplitAtMost = 2;
   EXPECT_GE(sweep.searches_per_line(0), kMeans);
   EXPECT_LE(sweep.searches_per_line(0), kMeans + kSplitAtMost);
+  // As in the traffic network, a stage contracts the fastest digit of the stage before's lines:
+  // the pair runs at once, its results checked against the oracle below.
+  EXPECT_TRUE(sweep.fused_with_next(0) || sweep.fused_with_next(1));
   expect_every_row_in_the_plans_order(a, rows, *plan);
 }
 

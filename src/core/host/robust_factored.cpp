@@ -54,9 +54,10 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
   gather_windows(a, rows, has_rows);
   number_q(a);
   for (const FactoredStage& stage : plan_.stages) {
-    walks_.push_back(walk_of(stage, plan_.variables));
-    share_searches(walks_.back(), stage.dimension);
+    walks_.push_back(StageWalk::of(stage, plan_.variables));
+    walks_.back().share_searches(window_of_[stage.dimension], packed_[stage.dimension].size());
   }
+  pair_stages();
 }
 
 void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
@@ -121,100 +122,65 @@ void RobustFactoredSweep::prepare(const double* values) {
   std::size_t in_size = 1;
   for (std::size_t count : counts_) in_size *= count;
   q_.resize(plan_.stages.back().output_size);
-  for (std::size_t k = 0; k < plan_.stages.size(); ++k) {
-    const std::size_t out_size = plan_.stages[k].output_size;
-    double* out = k + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[k % 2].reserve(out_size);
-    run_stage(k, in, in_size, out);
+  std::size_t free_tensor = 0;  // the ping-pong tensor that `in` is not
+  for (std::size_t k = 0; k < plan_.stages.size();) {
+    const std::size_t last = fuses_next_[k] ? k + 1 : k;
+    const std::size_t out_size = plan_.stages[last].output_size;
+    double* out = last + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[free_tensor].reserve(out_size);
+    if (last > k)
+      run_fused(k, in, in_size, out);
+    else
+      run_stage(k, in, in_size, out);
+    free_tensor ^= 1;
     in = out;
     in_size = out_size;
+    k = last + 1;
   }
 }
 
-RobustFactoredSweep::StageWalk RobustFactoredSweep::walk_of(const FactoredStage& stage,
-                                                             const std::vector<FactorVariable>& variables) {
-  StageWalk walk;
-  walk.free_offsets.assign(1, 0);
-  walk.free_tuples.assign(1, 0);
-  std::size_t output_stride = stage.output_size;
-  for (std::size_t j = 0; j < stage.output.size(); ++j) {
-    const std::size_t radix = stage.output[j].radix;
-    output_stride /= radix;
-    const auto tuple_stride = std::size_t(stage.tuple_stride[j]);
-    if (stage.input_stride[j]) {
-      const TensorDigit& digit = stage.output[j];
-      const bool jumps = !digit.post && variables[digit.id].space != FactorVariable::Space::State;
-      walk.carried.push_back({radix, std::size_t(stage.input_stride[j]), output_stride, tuple_stride, jumps});
-      continue;
-    }
-    std::vector<std::size_t> offsets, tuples;
-    for (std::size_t i = 0; i < walk.free_offsets.size(); ++i)
-      for (std::size_t digit = 0; digit < radix; ++digit) {
-        offsets.push_back(walk.free_offsets[i] + digit * output_stride);
-        tuples.push_back(walk.free_tuples[i] + digit * tuple_stride);
-      }
-    walk.free_offsets.swap(offsets);
-    walk.free_tuples.swap(tuples);
+void RobustFactoredSweep::pair_stages() {
+  // The pairs that leave the most entries of stage tensors unwritten: saved[k], the most from
+  // stage k on; a stage is in one pair at most.
+  const std::size_t stages = plan_.stages.size();
+  std::vector<std::size_t> saved(stages + 2, 0);
+  for (std::size_t k = stages; k-- > 0;) {
+    saved[k] = saved[k + 1];
+    if (fuses_next(k)) saved[k] = std::max(saved[k], std::size_t(plan_.stages[k].output_size) + saved[k + 2]);
   }
-  // Lines that differ in a state or post cell hold close values (a line is sorted from the one
-  // before); lines of another input or disturbance may not: those digits count slowest. The others
-  // by input stride, for the caches.
-  std::stable_sort(walk.carried.begin(), walk.carried.end(),
-                   [](const StageWalk::Carried& a, const StageWalk::Carried& b) {
-                     return a.jumps != b.jumps ? b.jumps : a.input_stride < b.input_stride;
-                   });
-  return walk;
-}
-
-void RobustFactoredSweep::share_searches(StageWalk& walk, std::size_t dimension) const {
-  for (const StageWalk::Carried& digit : walk.carried)
-    if (digit.tuple_stride) return;
-  const std::vector<std::uint32_t>& window_of = window_of_[dimension];
-  std::vector<std::uint32_t> search_of_window(packed_[dimension].size(), ~std::uint32_t(0));
-  walk.search_of.resize(walk.free_tuples.size());
-  for (std::size_t i = 0; i < walk.free_tuples.size(); ++i) {
-    std::uint32_t& search = search_of_window[window_of[walk.free_tuples[i]]];
-    if (search == ~std::uint32_t(0)) {
-      search = std::uint32_t(walk.searched.size());
-      walk.searched.push_back(i);
-    }
-    walk.search_of[i] = search;
+  fuses_next_.assign(stages, false);
+  for (std::size_t k = 0; k < stages;) {
+    fuses_next_[k] = saved[k] != saved[k + 1];
+    k += fuses_next_[k] ? 2 : 1;
   }
 }
 
-// The carried digits of a stage's lines, counted up line by line: consecutive lines are
-// consecutive values of the carried digits, fastest first (no division per line).
-struct RobustFactoredSweep::LineCursor {
-  explicit LineCursor(const std::vector<StageWalk::Carried>& carried) : carried(carried), digits(carried.size()) {}
-  // To line `line`, by division.
-  void seek(std::size_t line) {
-    input = output = tuple = 0;
-    std::size_t lines_below = 1;
-    for (std::size_t j = 0; j < carried.size(); ++j) {
-      digits[j] = line / lines_below % carried[j].radix;
-      lines_below *= carried[j].radix;
-      input += digits[j] * carried[j].input_stride;
-      output += digits[j] * carried[j].output_stride;
-      tuple += digits[j] * carried[j].tuple_stride;
-    }
-  }
-  // To the next line.
-  void next() {
-    for (std::size_t j = 0; j < carried.size(); ++j) {
-      const StageWalk::Carried& digit = carried[j];
-      input += digit.input_stride;
-      output += digit.output_stride;
-      tuple += digit.tuple_stride;
-      if (++digits[j] < digit.radix) return;
-      input -= digit.radix * digit.input_stride;
-      output -= digit.radix * digit.output_stride;
-      tuple -= digit.radix * digit.tuple_stride;
-      digits[j] = 0;
-    }
-  }
-  const std::vector<StageWalk::Carried>& carried;
-  std::vector<std::size_t> digits;
-  std::size_t input = 0, output = 0, tuple = 0;  // the line's first entry, results and tuples
-};
+bool RobustFactoredSweep::fuses_next(std::size_t k) const {
+  if (k + 1 >= plan_.stages.size() || walks_[k].carried.empty()) return false;
+  const StageWalk::Carried& fastest = walks_[k].carried[0];
+  const FactoredStage& next = plan_.stages[k + 1];
+  // The fastest digit of stage k's lines is the post cell that stage k + 1 contracts: it has that
+  // digit's stride in stage k's output, and its count.
+  return fastest.output_stride == next.contracted_stride && fastest.radix == counts_[next.dimension];
+}
+
+bool RobustFactoredSweep::sorts(std::size_t k) const {
+  // A sort pays for itself over many searches of one line: each of its searches then steps from
+  // key to key; without it, each step is a pass over the window.
+  return search_ == LineSearch::Auto ? searches_per_line(k) >= kSearchesWorthASort : search_ == LineSearch::Sorted;
+}
+
+namespace {
+
+// Workers take chunks of lines as they go: lines differ in cost (the searches' lengths), and an
+// even split would leave a worker idle at the end of the stage. At least 16 lines a chunk: a chunk
+// finds its first line by division, the others by counting; a multiple of `run` lines. The chunks
+// do not depend on the number of workers, nor, therefore, do the results, bit for bit (a chunk's
+// searches start from its own lines).
+std::size_t chunk_lines(std::size_t lines, std::size_t run) {
+  return std::max<std::size_t>(1, std::clamp<std::size_t>(lines / 64, 16, 256) / run) * run;
+}
+
+}  // namespace
 
 void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t in_size, double* out) {
   const FactoredStage& stage = plan_.stages[k];
@@ -223,59 +189,65 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
   require(lines * applied == stage.output_size, "every output entry reads one line");
-  const bool shared = !walk.search_of.empty();
-  const std::size_t searches = searches_per_line(k);
-  const PackedWindows& windows = packed_[dim];
-  const std::vector<std::uint32_t>& window_of = window_of_[dim];
   const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
-  // Workers take chunks of lines as they go: lines differ in cost (the searches' lengths), and an
-  // even split would leave a worker idle at the end of the stage. At least 16 lines a chunk: a
-  // chunk finds its first line by division, the others by counting. The chunks do not
-  // depend on the number of workers, nor, therefore, do the results, bit for bit (a chunk's
-  // searches start from its own lines).
-  const std::size_t chunk = std::clamp<std::size_t>(lines / 64, 16, 256);
-  // A sort pays for itself over many searches of one line: each of its searches then steps from
-  // key to key; without it, each step is a pass over the window.
-  const bool sorted = search_ == LineSearch::Auto ? searches >= kSearchesWorthASort : search_ == LineSearch::Sorted;
+  const std::size_t chunk = chunk_lines(lines, 1);
   std::atomic<std::size_t> next_line{0};
   parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
-    SortedLine line(length);
-    // Where the search of each of the line's windows ended on the previous line (a position):
-    // neighbouring lines hold close values, and their i-th windows are one tuple or neighbouring
-    // ones, so the threshold sits at the same cell or next to it.
-    std::vector<std::uint32_t> ends(searches);
-    std::vector<const PackedWindow*> line_windows(searches);
-    std::size_t windows_tuple_base = ~std::size_t(0);  // whose windows line_windows holds
-    std::vector<double> bounds(searches);
-    ThresholdSearches batch;
+    LineSearcher searcher(walk, packed_[dim], window_of_[dim], length, bound_, sorts(k), unit_);
     LineCursor cursor(walk.carried);
     for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
       const std::size_t last = std::min(first + chunk, lines);
       cursor.seek(first);
       for (std::size_t index = first; index < last; ++index, cursor.next()) {
-        const std::size_t base = cursor.input, output_base = cursor.output, tuple_base = cursor.tuple;
-        const bool previous_line = index > first;  // a chunk's lines alone decide its results, bit for bit
-        for (std::size_t a = 0; a < length; ++a) line.keys()[a] = sign * in[base + a * stride];
-        if (tuple_base != windows_tuple_base)  // consecutive lines mostly read the same windows
-          for (std::size_t s = 0; s < searches; ++s)
-            line_windows[s] = &windows[window_of[tuple_base + walk.free_tuples[shared ? walk.searched[s] : s]]];
-        windows_tuple_base = tuple_base;
-        if (sorted) {
-          line.sort(previous_line);
-          // A chunk's first line: every search from the median key.
-          if (!previous_line) std::fill(ends.begin(), ends.end(), std::uint32_t(line.order(length / 2)));
-          batch.run(line, line_windows.data(), searches, bound_, ends.data(), bounds.data(), unit_);
-        } else {
-          // A chunk's first line: each search from where the previous window's ended.
-          std::size_t start = length / 2;
-          for (std::size_t s = 0; s < searches; ++s) {
-            if (previous_line) start = ends[s];
-            bounds[s] = threshold_scan(line.keys(), *line_windows[s], bound_, start, unit_);
-            ends[s] = std::uint32_t(start);
-          }
+        for (std::size_t a = 0; a < length; ++a) searcher.keys()[a] = sign * in[cursor.input + a * stride];
+        searcher.search(cursor.tuple, index > first);
+        for (std::size_t i = 0; i < applied; ++i) out[cursor.output + walk.free_offsets[i]] = searcher.bound(i);
+      }
+    }
+  });
+}
+
+void RobustFactoredSweep::run_fused(std::size_t k, const double* in, std::size_t in_size, double* out) {
+  const FactoredStage& stage = plan_.stages[k];
+  const std::size_t dim = stage.dimension, length = counts_[dim];
+  const std::size_t stride = std::size_t(stage.contracted_stride), lines = in_size / length;
+  const StageWalk& walk = walks_[k];
+  const std::size_t applied = walk.free_offsets.size();
+  require(fuses_next_[k] && lines * applied == stage.output_size, "stage k's lines give stage k + 1's");
+  const std::size_t next_dim = plan_.stages[k + 1].dimension, next_length = counts_[next_dim];
+  const StageWalk& next_walk = walks_[k + 1];
+  const std::size_t next_applied = next_walk.free_offsets.size();
+  const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
+  // A run: stage k's lines over its fastest digit, next_length of them; their results form
+  // `applied` lines of stage k + 1.
+  const std::size_t chunk = chunk_lines(lines, next_length);
+  std::atomic<std::size_t> next_line{0};
+  parallel_for(threads_, threads_, [&](unsigned, std::size_t, std::size_t) {
+    LineSearcher searcher(walk, packed_[dim], window_of_[dim], length, bound_, sorts(k), unit_);
+    LineSearcher next_searcher(next_walk, packed_[next_dim], window_of_[next_dim], next_length, bound_, sorts(k + 1),
+                               unit_);
+    LineCursor cursor(walk.carried), next_cursor(next_walk.carried);
+    std::vector<double> run_results(applied * next_length);  // [i][position along the fastest digit]
+    for (std::size_t first; (first = next_line.fetch_add(chunk)) < lines;) {
+      const std::size_t last = std::min(first + chunk, lines);
+      cursor.seek(first);
+      for (std::size_t run = first; run < last; run += next_length) {
+        const std::size_t run_output = cursor.output;  // W_k's offset of the run's first results
+        for (std::size_t position = 0; position < next_length; ++position, cursor.next()) {
+          for (std::size_t a = 0; a < length; ++a) searcher.keys()[a] = sign * in[cursor.input + a * stride];
+          searcher.search(cursor.tuple, run + position > first);
+          for (std::size_t i = 0; i < applied; ++i) run_results[i * next_length + position] = searcher.bound(i);
         }
-        for (std::size_t i = 0; i < applied; ++i)
-          out[output_base + walk.free_offsets[i]] = bounds[shared ? walk.search_of[i] : i];
+        // Stage k + 1's lines in an order where neighbours hold close values (good starts).
+        for (std::size_t m = 0; m < applied; ++m) {
+          const std::size_t i = walk.free_order[m];
+          next_cursor.seek_input(run_output + walk.free_offsets[i]);
+          const double* line = run_results.data() + i * next_length;
+          for (std::size_t a = 0; a < next_length; ++a) next_searcher.keys()[a] = sign * line[a];
+          next_searcher.search(next_cursor.tuple, run > first || m > 0);
+          for (std::size_t j = 0; j < next_applied; ++j)
+            out[next_cursor.output + next_walk.free_offsets[j]] = next_searcher.bound(j);
+        }
       }
     }
   });

@@ -10,8 +10,11 @@
 // the same window (a linear map on the grid gives many cells one mean) share one search. A line
 // that feeds many searches is sorted first and searched in one batch (ThresholdSearches), one that
 // feeds few is not (threshold_scan()); each search starts where the search of the window in the
-// same place ended on the line before. The tensors are laid out for this (FactoredLayout::Lines): a line's results
-// are written side by side.
+// same place ended on the line before (host/stage_lines.hpp). The tensors are laid out for this
+// (FactoredLayout::Lines): a line's results are written side by side. Where a stage contracts the
+// post cell over which the stage before counts its lines fastest, the two run as a pair: each run
+// of the first stage's lines over that cell gives whole lines of the second, searched while in
+// cache, and the tensor between them is never written (traffic 3-d: 688 MB per bound and step).
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
 // stage may pick its distribution per remaining cell, a superset of the product set), and equal,
@@ -30,6 +33,7 @@
 #include "host/product_sweep.hpp"
 #include "host/row_bounds.hpp"
 #include "host/factored_plan.hpp"
+#include "host/stage_lines.hpp"
 #include "host/threshold_expectation.hpp"
 
 namespace amytiss::detail {
@@ -62,33 +66,26 @@ class RobustFactoredSweep {
   /// The elimination order e_1..e_d (post dimensions).
   const std::vector<std::size_t>& order() const { return plan_.order; }
   /// Searches per line of stage k: one per distinct window that the line's tuples read.
-  std::size_t searches_per_line(std::size_t k) const {
-    return walks_[k].search_of.empty() ? walks_[k].free_tuples.size() : walks_[k].searched.size();
-  }
+  std::size_t searches_per_line(std::size_t k) const { return walks_[k].searches_per_line(); }
+  /// Whether stage k + 1 searches stage k's results as they come, a run of lines at a time (W_k is
+  /// never written out): where stage k + 1 contracts the fastest digit of stage k's lines.
+  bool fused_with_next(std::size_t k) const { return fuses_next_[k]; }
 
  private:
-  // A stage's output digits split by what they do: those the input has name the line an entry
-  // reads; the others enumerate the tuples applied to that line (row-major, as the output).
-  struct StageWalk {
-    struct Carried {
-      std::size_t radix, input_stride, output_stride, tuple_stride;
-      bool jumps;  // an input or disturbance
-    };
-    // The lines' odometer, fastest first: by increasing input stride, inputs and disturbances last.
-    std::vector<Carried> carried;
-    std::vector<std::size_t> free_offsets, free_tuples;  // per combination of the other digits
-    // When no line digit picks the window (every line applies the same windows), one search per
-    // distinct window: the first combination that has it, and each combination's search. Empty:
-    // one search per combination.
-    std::vector<std::size_t> searched;
-    std::vector<std::uint32_t> search_of;
-  };
-  struct LineCursor;
-  static StageWalk walk_of(const FactoredStage& stage, const std::vector<FactorVariable>& variables);
-  // Fills the walk's searched and search_of where the windows do not depend on the line.
-  void share_searches(StageWalk& walk, std::size_t dimension) const;
   // Stage k from `in` (W_{k-1}, `in_size` entries) into `out` (W_k).
   void run_stage(std::size_t k, const double* in, std::size_t in_size, double* out);
+  // Stages k and k + 1 from `in` (W_{k-1}) into `out` (W_{k+1}), where stage k + 1 contracts the
+  // fastest digit of stage k's lines (fuses_next_[k]): each run of stage k's lines over that digit
+  // gives whole lines of stage k + 1, searched at once, while they are in cache; W_k is never
+  // written out.
+  void run_fused(std::size_t k, const double* in, std::size_t in_size, double* out);
+  // Whether stage k's lines, a run at a time, give whole lines of stage k + 1.
+  bool fuses_next(std::size_t k) const;
+  // Fills fuses_next_: the stage pairs that run_fused() takes, those that leave the most entries of
+  // W_k unwritten.
+  void pair_stages();
+  // Whether stage k sorts its lines.
+  bool sorts(std::size_t k) const;
   // Per post dimension, the distinct windows of the tuples of the components it reads (tuple
   // digits major to minor as plan.reads lists them), packed for the threshold search, and the
   // window of each tuple.
@@ -104,6 +101,7 @@ class RobustFactoredSweep {
   std::vector<std::vector<std::uint32_t>> window_of_;  // [dimension][tuple]: its window in packed_
   VectorUnit unit_ = widest_vector_unit();  // the searches' passes
   std::vector<StageWalk> walks_;           // per stage
+  std::vector<bool> fuses_next_;           // per stage: run_fused() with the next (pairs do not overlap)
   std::shared_ptr<SweepBuffers> buffers_;  // the ping-pong W_k
   std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;
