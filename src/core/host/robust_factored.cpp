@@ -182,13 +182,17 @@ std::size_t chunk_lines(std::size_t lines, std::size_t run) {
 
 }  // namespace
 
-void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t in_size, double* out) {
+RobustFactoredSweep::LineShape RobustFactoredSweep::lines_of(std::size_t k, std::size_t in_size) const {
   const FactoredStage& stage = plan_.stages[k];
-  const std::size_t dim = stage.dimension, length = counts_[dim];
-  const std::size_t stride = std::size_t(stage.contracted_stride), lines = in_size / length;
+  const std::size_t length = counts_[stage.dimension], lines = in_size / length;
+  require(lines * walks_[k].free_offsets.size() == stage.output_size, "every output entry reads one line");
+  return {stage.dimension, length, std::size_t(stage.contracted_stride), lines};
+}
+
+void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t in_size, double* out) {
+  const auto [dim, length, stride, lines] = lines_of(k, in_size);
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
-  require(lines * applied == stage.output_size, "every output entry reads one line");
   const double sign = bound_ == Bound::Lower ? 1.0 : -1.0;
   const std::size_t chunk = chunk_lines(lines, 1);
   std::atomic<std::size_t> next_line{0};
@@ -208,12 +212,10 @@ void RobustFactoredSweep::run_stage(std::size_t k, const double* in, std::size_t
 }
 
 void RobustFactoredSweep::run_fused(std::size_t k, const double* in, std::size_t in_size, double* out) {
-  const FactoredStage& stage = plan_.stages[k];
-  const std::size_t dim = stage.dimension, length = counts_[dim];
-  const std::size_t stride = std::size_t(stage.contracted_stride), lines = in_size / length;
+  const auto [dim, length, stride, lines] = lines_of(k, in_size);
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
-  require(fuses_next_[k] && lines * applied == stage.output_size, "stage k's lines give stage k + 1's");
+  require(fuses_next_[k], "stage k's lines give stage k + 1's");
   const std::size_t next_dim = plan_.stages[k + 1].dimension, next_length = counts_[next_dim];
   const StageWalk& next_walk = walks_[k + 1];
   const std::size_t next_applied = next_walk.free_offsets.size();

@@ -72,6 +72,12 @@ class RobustFactoredSweep {
   bool fused_with_next(std::size_t k) const { return fuses_next_[k]; }
 
  private:
+  // Stage k's lines in its input of `in_size` entries: the dimension it contracts, the lines'
+  // length and stride, and their number.
+  struct LineShape {
+    std::size_t dimension, length, stride, lines;
+  };
+  LineShape lines_of(std::size_t k, std::size_t in_size) const;
   // Stage k from `in` (W_{k-1}, `in_size` entries) into `out` (W_k).
   void run_stage(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Stages k and k + 1 from `in` (W_{k-1}) into `out` (W_{k+1}), where stage k + 1 contracts the
