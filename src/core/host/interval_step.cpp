@@ -61,9 +61,14 @@ std::string IntervalStep::method() const {
   if (set_ == AmbiguitySet::Joint) return "the joint interval MDP row by row";
   if (sweep_) return "the product set over whole tables";
   if (!factored_) return "the product set row by row (no variable elimination: " + no_elimination_ + ")";
-  std::string order;
-  for (std::size_t d : factored_->order()) order += " x'" + std::to_string(d);
-  return "the product set by variable elimination (eliminates" + order + ")";
+  std::string order, pairs;
+  const std::vector<std::size_t>& eliminated = factored_->order();
+  for (std::size_t k = 0; k < eliminated.size(); ++k) {
+    order += " x'" + std::to_string(eliminated[k]);
+    if (factored_->fused_with_next(k))
+      pairs += "; x'" + std::to_string(eliminated[k]) + " and x'" + std::to_string(eliminated[k + 1]) + " as a pair";
+  }
+  return "the product set by variable elimination (eliminates" + order + pairs + ")";
 }
 
 void IntervalStep::reset_stage_caches() {
