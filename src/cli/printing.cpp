@@ -125,11 +125,11 @@ void print_roofline(const SynthesisReport& report) {
   // Caches serve part of the operand bytes: the intensity is a lower bound and a phase may beat its roof.
   std::printf("roofline (bandwidth %.1f GB/s measured, peak %.0f GMAC/s; MAC/B over operand bytes, a lower "
               "bound of the intensity: %% roof may pass 100):\n", bandwidth / 1e9, peak / 1e9);
-  std::printf("  %-28s %12s %12s %8s %12s %8s\n", "phase", "MAC/B", "roof GMAC/s", "bound", "GMAC/s", "% roof");
+  std::printf("  %-33s %12s %12s %8s %12s %8s\n", "phase", "MAC/B", "roof GMAC/s", "bound", "GMAC/s", "% roof");
   auto print_row = [&](const std::string& name, double multiply_adds, double bytes, double seconds) {
     if (multiply_adds <= 0 || bytes <= 0 || seconds <= 0) return;
     const RooflinePoint point = roofline_point(peak, bandwidth, multiply_adds, bytes, seconds);
-    std::printf("  %-28s %12.4g %12.3f %8s %12.3f %8.1f\n", name.c_str(), point.intensity, point.roof / 1e9,
+    std::printf("  %-33s %12.4g %12.3f %8s %12.3f %8.1f\n", name.c_str(), point.intensity, point.roof / 1e9,
                 to_string(point.bound).c_str(), point.achieved / 1e9, 100.0 * point.fraction_of_roof);
   };
   double step_multiply_adds = 0, step_bytes = 0, step_seconds = 0;
@@ -155,12 +155,12 @@ void print_profile(const SynthesisReport& report) {
   std::printf("profile (%s):\n", report.device.c_str());
   if (peak > 0)
     std::printf("  double multiply-add peak %.0f GMAC/s: %s\n", peak / 1e9, report.peak_basis.c_str());
-  std::printf("  %-28s %10s %14s %14s %9s %7s %11s\n", "phase", "seconds", "pairs/s", "multiply-adds", "GMAC/s",
+  std::printf("  %-33s %10s %14s %14s %9s %7s %11s\n", "phase", "seconds", "pairs/s", "multiply-adds", "GMAC/s",
               "% peak", "GB/s (ops)");
   auto print_row = [&](const std::string& name, double seconds, double pairs_per_second, double multiply_adds,
                        double bytes) {
     const double rate = seconds > 0 ? multiply_adds / seconds : 0.0;
-    std::printf("  %-28s %10.4f %14.4g %14.4g %9.3f %7.2f %11.2f\n", name.c_str(), seconds, pairs_per_second,
+    std::printf("  %-33s %10.4f %14.4g %14.4g %9.3f %7.2f %11.2f\n", name.c_str(), seconds, pairs_per_second,
                 multiply_adds, rate / 1e9, peak > 0 ? 100.0 * rate / peak : 0.0,
                 seconds > 0 ? bytes / seconds / 1e9 : 0.0);
   };

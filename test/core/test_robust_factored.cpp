@@ -5,7 +5,8 @@
 // the same bits on any number of workers;
 // that oracle is product_expectation() in the order (d-1, ..., 0) and lies within the joint
 // interval MDP's bounds in every order; the step takes this way where the sweep over whole tables
-// does not pay, and its bounds then stay sound against the joint reference.
+// does not pay, and its bounds then stay sound against the joint reference; the profile's breakdown
+// gives the stages' seconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -215,7 +216,16 @@ TEST(RobustFactored, StepTakesVariableEliminationAndStaysWithinTheJointBounds) {
   EXPECT_NE(step.method().find("x'1 and x'0 as a pair"), std::string::npos) << step.method();
   SynthesisOptions product, joint;
   joint.compute.device = DeviceKind::Reference;
-  const Policy factored = synthesize(a, product, nullptr);
+  SynthesisReport report;
+  const Policy factored = synthesize(a, product, &report);
+  // The profile's breakdown: the pair's seconds, within the steps' (both bounds).
+  double step_seconds = 0, pair_seconds = -1;
+  for (const PhaseReport& phase : report.phases) {
+    if (phase.kind == PhaseKind::Step) step_seconds += phase.seconds;
+    if (phase.is_breakdown() && phase.name == "stages 0-1 (x'1 x'0, all steps)") pair_seconds = phase.seconds;
+  }
+  EXPECT_GT(pair_seconds, 0.0) << "a breakdown phase for the pair";
+  EXPECT_LE(pair_seconds, step_seconds);
   const Policy reference = synthesize(a, joint, nullptr);
   for (std::size_t x = 0; x < a.states.size(); ++x) {
     EXPECT_GE(factored.value(0, x), reference.value(0, x) - kOrderSlack) << "cell " << x;

@@ -71,6 +71,24 @@ std::string IntervalStep::method() const {
   return "the product set by variable elimination (eliminates" + order + pairs + ")";
 }
 
+std::vector<std::pair<std::string, double>> IntervalStep::stage_seconds() const {
+  std::vector<std::pair<std::string, double>> stages;
+  if (!factored_) return stages;
+  const std::vector<std::size_t>& eliminated = factored_->order();
+  for (std::size_t k = 0; k < eliminated.size(); ++k) {
+    const std::string dimension = "x'" + std::to_string(eliminated[k]);
+    if (!factored_->fused_with_next(k)) {
+      stages.emplace_back("stage " + std::to_string(k) + " (" + dimension + ", all steps)", factored_->stage_seconds(k));
+      continue;
+    }
+    stages.emplace_back("stages " + std::to_string(k) + "-" + std::to_string(k + 1) + " (" + dimension + " x'" +
+                            std::to_string(eliminated[k + 1]) + ", all steps)",
+                        factored_->stage_seconds(k));
+    ++k;
+  }
+  return stages;
+}
+
 void IntervalStep::reset_stage_caches() {
   for (std::size_t d = 0; d < stage_caches_.size(); ++d)
     for (std::size_t i = 0; i < stage_cache_entries_[d]; ++i)

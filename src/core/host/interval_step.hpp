@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
@@ -38,6 +39,9 @@ class IntervalStep : public BellmanStep {
   /// How the step computes the rows' bounds, for the notes: the product set over whole tables, by
   /// variable elimination (with its order) or row by row, or the joint interval MDP.
   std::string method() const;
+  /// The variable elimination's stages, a pair as one ("stage 0 (x'1, all steps)", "stages 1-2
+  /// (x'0 x'2, all steps)"), with their seconds over every step so far; empty without it.
+  std::vector<std::pair<std::string, double>> stage_seconds() const;
 
  private:
   double expectation(std::size_t row, const double* in, ProductScratch& scratch) const;

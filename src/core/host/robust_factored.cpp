@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "amytiss/format.hpp"
+#include "amytiss/stopwatch.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -58,6 +59,7 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
     walks_.back().share_searches(window_of_[stage.dimension], packed_[stage.dimension].size());
   }
   pair_stages();
+  stage_seconds_.assign(plan_.stages.size(), 0.0);
 }
 
 void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
@@ -127,10 +129,12 @@ void RobustFactoredSweep::prepare(const double* values) {
     const std::size_t last = fuses_next_[k] ? k + 1 : k;
     const std::size_t out_size = plan_.stages[last].output_size;
     double* out = last + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[free_tensor].reserve(out_size);
+    const auto start = SteadyClock::now();
     if (last > k)
       run_fused(k, in, in_size, out);
     else
       run_stage(k, in, in_size, out);
+    stage_seconds_[k] += seconds_since(start);
     free_tensor ^= 1;
     in = out;
     in_size = out_size;

@@ -70,6 +70,9 @@ class RobustFactoredSweep {
   /// Whether stage k + 1 searches stage k's results as they come, a run of lines at a time (W_k is
   /// never written out): where stage k + 1 contracts the fastest digit of stage k's lines.
   bool fused_with_next(std::size_t k) const { return fuses_next_[k]; }
+  /// The seconds of stage k over every prepare() so far; a pair's at its first stage (0 at its
+  /// second).
+  double stage_seconds(std::size_t k) const { return stage_seconds_[k]; }
 
  private:
   // Stage k's lines in its input of `in_size` entries: the dimension it contracts, the lines'
@@ -108,6 +111,7 @@ class RobustFactoredSweep {
   VectorUnit unit_ = widest_vector_unit();  // the searches' passes
   std::vector<StageWalk> walks_;           // per stage
   std::vector<bool> fuses_next_;           // per stage: run_fused() with the next (pairs do not overlap)
+  std::vector<double> stage_seconds_;      // per stage, over every prepare()
   std::shared_ptr<SweepBuffers> buffers_;  // the ping-pong W_k
   std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;

@@ -47,7 +47,12 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
        "continuous-system bounds: image enclosures of every cell, " + std::to_string(rows.intervals()) +
            " per-dimension mass intervals (" + format_bytes(double(rows.bytes())) + "), " + lower.method() +
            " on " + std::to_string(threads) + " host thread" + (threads == 1 ? "" : "s")});
-  return run_backward_bounds(a, lower, upper, reporter);
+  Policy policy = run_backward_bounds(a, lower, upper, reporter);
+  // The steps' time by stage of the variable elimination, both bounds together.
+  const auto lower_stages = lower.stage_seconds(), upper_stages = upper.stage_seconds();
+  for (std::size_t i = 0; i < lower_stages.size() && i < upper_stages.size(); ++i)
+    reporter.phase(PhaseKind::Breakdown, lower_stages[i].first, lower_stages[i].second + upper_stages[i].second);
+  return policy;
 }
 
 std::string lower_targets_text(const std::vector<CellRole>& lower_roles, SpecType spec) {
