@@ -123,9 +123,18 @@ void LineSearcher::search(std::size_t tuple_base, bool after_neighbour) {
   windows_tuple_base_ = tuple_base;
   if (sorted_) {
     line_.sort(after_neighbour);
-    // Afresh: every search from the median key.
-    if (!after_neighbour) std::fill(ends_.begin(), ends_.end(), std::uint32_t(line_.order(length / 2)));
-    batch_.run(line_, line_windows_.data(), searches_, bound_, ends_.data(), bounds_.data(), unit_);
+    if (after_neighbour) {
+      batch_.run(line_, line_windows_.data(), searches_, bound_, ends_.data(), bounds_.data(), unit_);
+      return;
+    }
+    // Afresh: the first search from the median key, each other from where the previous window's
+    // ended (neighbouring windows have their thresholds close by), one at a time.
+    std::uint32_t start = std::uint32_t(line_.order(length / 2));
+    for (std::size_t s = 0; s < searches_; ++s) {
+      ends_[s] = start;
+      batch_.run(line_, &line_windows_[s], 1, bound_, &ends_[s], &bounds_[s], unit_);
+      start = ends_[s];
+    }
     return;
   }
   // Afresh: each search from where the previous window's ended.
