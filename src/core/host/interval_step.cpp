@@ -78,7 +78,8 @@ std::vector<std::pair<std::string, double>> IntervalStep::stage_seconds() const 
   for (std::size_t k = 0; k < eliminated.size(); ++k) {
     const std::string dimension = "x'" + std::to_string(eliminated[k]);
     if (!factored_->fused_with_next(k)) {
-      stages.emplace_back("stage " + std::to_string(k) + " (" + dimension + ", all steps)", factored_->stage_seconds(k));
+      stages.emplace_back("stage " + std::to_string(k) + " (" + dimension + ", all steps)",
+                          factored_->stage_seconds(k));
       continue;
     }
     stages.emplace_back("stages " + std::to_string(k) + "-" + std::to_string(k + 1) + " (" + dimension + " x'" +
