@@ -62,30 +62,25 @@ std::string IntervalStep::method() const {
   if (sweep_) return "the product set over whole tables";
   if (!factored_) return "the product set row by row (no variable elimination: " + no_elimination_ + ")";
   std::string order, pairs;
-  const std::vector<std::size_t>& eliminated = factored_->order();
-  for (std::size_t k = 0; k < eliminated.size(); ++k) {
-    order += " x'" + std::to_string(eliminated[k]);
-    if (factored_->fused_with_next(k))
-      pairs += "; x'" + std::to_string(eliminated[k]) + " and x'" + std::to_string(eliminated[k + 1]) + " as a pair";
-  }
+  for (std::size_t d : factored_->order()) order += " x'" + std::to_string(d);
+  for (const RobustFactoredSweep::StageRun& run : factored_->runs())
+    if (run.last > run.first)
+      pairs += "; x'" + std::to_string(factored_->order()[run.first]) + " and x'" +
+               std::to_string(factored_->order()[run.last]) + " as a pair";
   return "the product set by variable elimination (eliminates" + order + pairs + ")";
 }
 
 std::vector<std::pair<std::string, double>> IntervalStep::stage_seconds() const {
   std::vector<std::pair<std::string, double>> stages;
   if (!factored_) return stages;
-  const std::vector<std::size_t>& eliminated = factored_->order();
-  for (std::size_t k = 0; k < eliminated.size(); ++k) {
-    const std::string dimension = "x'" + std::to_string(eliminated[k]);
-    if (!factored_->fused_with_next(k)) {
-      stages.emplace_back("stage " + std::to_string(k) + " (" + dimension + ", all steps)",
-                          factored_->stage_seconds(k));
-      continue;
-    }
-    stages.emplace_back("stages " + std::to_string(k) + "-" + std::to_string(k + 1) + " (" + dimension + " x'" +
-                            std::to_string(eliminated[k + 1]) + ", all steps)",
-                        factored_->stage_seconds(k));
-    ++k;
+  auto dimension = [&](std::size_t k) { return "x'" + std::to_string(factored_->order()[k]); };
+  for (const RobustFactoredSweep::StageRun& run : factored_->runs()) {
+    const std::string stage =
+        run.last > run.first
+            ? "stages " + std::to_string(run.first) + "-" + std::to_string(run.last) + " (" + dimension(run.first) +
+                  " " + dimension(run.last)
+            : "stage " + std::to_string(run.first) + " (" + dimension(run.first);
+    stages.emplace_back(stage + ", all steps)", run.seconds);
   }
   return stages;
 }

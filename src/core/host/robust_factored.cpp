@@ -59,7 +59,6 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
     walks_.back().share_searches(window_of_[stage.dimension], packed_[stage.dimension].size());
   }
   pair_stages();
-  stage_seconds_.assign(plan_.stages.size(), 0.0);
 }
 
 void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
@@ -125,20 +124,19 @@ void RobustFactoredSweep::prepare(const double* values) {
   for (std::size_t count : counts_) in_size *= count;
   q_.resize(plan_.stages.back().output_size);
   std::size_t free_tensor = 0;  // the ping-pong tensor that `in` is not
-  for (std::size_t k = 0; k < plan_.stages.size();) {
-    const std::size_t last = fuses_next_[k] ? k + 1 : k;
-    const std::size_t out_size = plan_.stages[last].output_size;
-    double* out = last + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[free_tensor].reserve(out_size);
+  for (StageRun& run : runs_) {
+    const std::size_t out_size = plan_.stages[run.last].output_size;
+    double* out =
+        run.last + 1 == plan_.stages.size() ? q_.data() : buffers_->stage_tensors[free_tensor].reserve(out_size);
     const auto start = SteadyClock::now();
-    if (last > k)
-      run_fused(k, in, in_size, out);
+    if (run.last > run.first)
+      run_fused(run.first, in, in_size, out);
     else
-      run_stage(k, in, in_size, out);
-    stage_seconds_[k] += seconds_since(start);
+      run_stage(run.first, in, in_size, out);
+    run.seconds += seconds_since(start);
     free_tensor ^= 1;
     in = out;
     in_size = out_size;
-    k = last + 1;
   }
 }
 
@@ -151,10 +149,10 @@ void RobustFactoredSweep::pair_stages() {
     saved[k] = saved[k + 1];
     if (fuses_next(k)) saved[k] = std::max(saved[k], std::size_t(plan_.stages[k].output_size) + saved[k + 2]);
   }
-  fuses_next_.assign(stages, false);
   for (std::size_t k = 0; k < stages;) {
-    fuses_next_[k] = saved[k] != saved[k + 1];
-    k += fuses_next_[k] ? 2 : 1;
+    const std::size_t last = saved[k] != saved[k + 1] ? k + 1 : k;
+    runs_.push_back({k, last});
+    k = last + 1;
   }
 }
 
@@ -219,7 +217,7 @@ void RobustFactoredSweep::run_fused(std::size_t k, const double* in, std::size_t
   const auto [dim, length, stride, lines] = lines_of(k, in_size);
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
-  require(fuses_next_[k], "stage k's lines give stage k + 1's");
+  require(fuses_next(k), "stage k's lines give stage k + 1's");
   const std::size_t next_dim = plan_.stages[k + 1].dimension, next_length = counts_[next_dim];
   const StageWalk& next_walk = walks_[k + 1];
   const std::size_t next_applied = next_walk.free_offsets.size();

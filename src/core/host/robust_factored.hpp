@@ -67,12 +67,20 @@ class RobustFactoredSweep {
   const std::vector<std::size_t>& order() const { return plan_.order; }
   /// Searches per line of stage k: one per distinct window that the line's tuples read.
   std::size_t searches_per_line(std::size_t k) const { return walks_[k].searches_per_line(); }
-  /// Whether stage k + 1 searches stage k's results as they come, a run of lines at a time (W_k is
-  /// never written out): where stage k + 1 contracts the fastest digit of stage k's lines.
-  bool fused_with_next(std::size_t k) const { return fuses_next_[k]; }
-  /// The seconds of stage k over every prepare() so far; a pair's at its first stage (0 at its
-  /// second).
-  double stage_seconds(std::size_t k) const { return stage_seconds_[k]; }
+  /// The stages as they run: one alone, or a pair where stage first + 1 searches stage first's
+  /// results as they come, a run of lines at a time (W_first is never written out), because it
+  /// contracts the fastest digit of stage first's lines. With their seconds over every prepare().
+  struct StageRun {
+    std::size_t first, last;
+    double seconds = 0.0;
+  };
+  const std::vector<StageRun>& runs() const { return runs_; }
+  /// Whether stage k runs as a pair with stage k + 1.
+  bool fused_with_next(std::size_t k) const {
+    for (const StageRun& run : runs_)
+      if (run.first == k) return run.last > k;
+    return false;
+  }
 
  private:
   // Stage k's lines in its input of `in_size` entries: the dimension it contracts, the lines'
@@ -84,13 +92,13 @@ class RobustFactoredSweep {
   // Stage k from `in` (W_{k-1}, `in_size` entries) into `out` (W_k).
   void run_stage(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Stages k and k + 1 from `in` (W_{k-1}) into `out` (W_{k+1}), where stage k + 1 contracts the
-  // fastest digit of stage k's lines (fuses_next_[k]): each run of stage k's lines over that digit
+  // fastest digit of stage k's lines (a pair of runs_): each run of stage k's lines over that digit
   // gives whole lines of stage k + 1, searched at once, while they are in cache; W_k is never
   // written out.
   void run_fused(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Whether stage k's lines, a run at a time, give whole lines of stage k + 1.
   bool fuses_next(std::size_t k) const;
-  // Fills fuses_next_: the stage pairs that run_fused() takes, those that leave the most entries of
+  // Fills runs_: the stage pairs that run_fused() takes are those that leave the most entries of
   // W_k unwritten.
   void pair_stages();
   // Whether stage k sorts its lines.
@@ -110,8 +118,7 @@ class RobustFactoredSweep {
   std::vector<std::vector<std::uint32_t>> window_of_;  // [dimension][tuple]: its window in packed_
   VectorUnit unit_ = widest_vector_unit();  // the searches' passes
   std::vector<StageWalk> walks_;           // per stage
-  std::vector<bool> fuses_next_;           // per stage: run_fused() with the next (pairs do not overlap)
-  std::vector<double> stage_seconds_;      // per stage, over every prepare()
+  std::vector<StageRun> runs_;             // every stage once, in order
   std::shared_ptr<SweepBuffers> buffers_;  // the ping-pong W_k
   std::vector<double> q_;
   std::vector<std::size_t> cell_offset_, input_offset_, disturbance_offset_;
