@@ -238,12 +238,11 @@ void ThresholdSearches::run(const SortedLine& line, const PackedWindow* const* w
 double threshold_scan(const double* keys, const PackedWindow& window, Bound bound, std::size_t& start,
                       VectorUnit unit) {
   const ExtraKeys extra(bound);
-  const double* extra_keys = extra.keys;
   // Each pass finds D's value and slopes at t and the window's next keys with slack either side;
   // the search moves to the next key while D rises there, which is a fresh pass away.
   ScanSums sums;
   double t = keys[start];
-  double best = sound_dual(unit, keys, window, extra_keys, t, sums);
+  double best = sound_dual(unit, keys, window, extra, t, sums);
   const int direction = rising_direction(sums.above, sums.below);
   for (std::size_t steps = 0; direction != 0 && steps < window.count + 2; ++steps) {
     const double next = direction > 0 ? sums.up : sums.down;
@@ -251,7 +250,7 @@ double threshold_scan(const double* keys, const PackedWindow& window, Bound boun
     if (std::abs(next) == kInfinity) break;
     t = next;
     if (position != kNoPosition) start = window.first + position;
-    best = std::max(best, sound_dual(unit, keys, window, extra_keys, t, sums));
+    best = std::max(best, sound_dual(unit, keys, window, extra, t, sums));
     if (direction > 0 ? sums.above >= 1.0 : sums.below <= 1.0) break;
   }
   return bound_of_keys(best, bound);

@@ -44,6 +44,17 @@ enum class PassKind { Slopes, Neighbours };
 template <PassKind kKind>
 using SumsOf = std::conditional_t<kKind == PassKind::Neighbours, ScanSums, PassSums>;
 
+// One block of kThresholdLanes outcomes into D's sums at threshold t; the lanes whose key is above t.
+__attribute__((always_inline)) inline LaneMask add_block(Lanes key, Lanes low, Lanes high, Lanes threshold,
+                                                         Lanes& above, Lanes& weighted, Lanes& below) {
+  const LaneMask over = key > threshold;
+  const Lanes weight = select(over, low, high);
+  above += weight;
+  weighted += weight * key;
+  below += select(key < threshold, high, low);
+  return over;
+}
+
 // The pass's body, inlined into one function per instruction set.
 template <PassKind kKind>
 __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys, const double* lo, const double* hi,
@@ -58,11 +69,7 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
     std::memcpy(&key, keys + j, sizeof key);
     std::memcpy(&low, lo + j, sizeof low);
     std::memcpy(&high, hi + j, sizeof high);
-    const LaneMask over = key > threshold;
-    const Lanes weight = select(over, low, high);
-    above += weight;
-    weighted += weight * key;
-    below += select(key < threshold, high, low);
+    const LaneMask over = add_block(key, low, high, threshold, above, weighted, below);
     if constexpr (kKind == PassKind::Neighbours) {
       const LaneMask under = key < threshold;
       const LaneMask slack = high > low;
@@ -78,17 +85,14 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
     std::memcpy(&key, outcome_keys, sizeof key);
     std::memcpy(&low, lo + padded_count, sizeof low);
     std::memcpy(&high, hi + padded_count, sizeof high);
-    const Lanes weight = select(key > threshold, low, high);
-    above += weight;
-    weighted += weight * key;
-    below += select(key < threshold, high, low);
+    add_block(key, low, high, threshold, above, weighted, below);
   }
   SumsOf<kKind> sums;
   sums.above = lane_sum(above);
   sums.weighted = lane_sum(weighted);
   sums.below = lane_sum(below);
-  for (std::size_t lane = 0; lane < kThresholdLanes; ++lane) {
-    if constexpr (kKind == PassKind::Neighbours) {
+  if constexpr (kKind == PassKind::Neighbours)
+    for (std::size_t lane = 0; lane < kThresholdLanes; ++lane) {
       if (up[lane] < sums.up) {
         sums.up = up[lane];
         sums.up_position = std::size_t(up_at[lane]);
@@ -98,7 +102,6 @@ __attribute__((always_inline)) inline SumsOf<kKind> pass_body(const double* keys
         sums.down_position = std::size_t(down_at[lane]);
       }
     }
-  }
   return sums;
 }
 
@@ -141,7 +144,7 @@ __attribute__((always_inline)) inline double dual_less_error(const PackedWindow&
 
 }  // namespace
 
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
+double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const ExtraKeys& extra, double t,
                   ScanSums& sums) {
   const double* cells = keys + window.first;
 #ifdef AMYTISS_HAS_AVX2_PASS
@@ -150,8 +153,8 @@ double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& windo
   else
 #endif
     sums = baseline_scan_pass(cells, window.lo, window.hi, window.padded_count(), t);
-  add_outcome(sums, extra_keys[0], window.leave, t);
-  add_outcome(sums, extra_keys[1], window.cut, t);
+  add_outcome(sums, extra.keys[0], window.leave, t);
+  add_outcome(sums, extra.keys[1], window.cut, t);
   return dual_less_error(window, t, sums);
 }
 

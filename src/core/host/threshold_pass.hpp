@@ -34,9 +34,9 @@ struct ExtraKeys {
   double keys[kThresholdLanes];
 };
 
-/// D(t) of a window over keys[window.first ..] (with leave and cut, keys extra_keys[0..1]) less its
+/// D(t) of a window over keys[window.first ..] (with leave and cut, keys extra.keys[0..1]) less its
 /// error bound, with the sums behind it and the nearest keys (the unsorted search's pass).
-double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const double* extra_keys, double t,
+double sound_dual(VectorUnit unit, const double* keys, const PackedWindow& window, const ExtraKeys& extra, double t,
                   ScanSums& sums);
 
 /// A sorted search's pass at threshold t (a key of the line `keys`, or of leave or cut).
