@@ -7,49 +7,20 @@
 #include <sstream>
 
 #include "amytiss/abstraction.hpp"
+#include "opencl/factored/kernel_text.hpp"
+#include "opencl/factored/row_kernel.hpp"
 
 namespace amytiss::detail {
 namespace {
 
-
-// Digit decoding of `index` into the sums of digit * stride for each named target, minor digit
-// first. Digits whose strides are all zero are skipped, except for advancing the remainder.
-void decode_digits(std::ostringstream& s, const std::string& index, const std::vector<std::uint64_t>& radices,
-                   const std::vector<std::vector<std::uint64_t>>& strides, const std::vector<std::string>& targets) {
-  s << "  ulong rest = " << index << ";\n";
-  for (std::size_t j = radices.size(); j-- > 0;) {
-    bool used = false;
-    for (const auto& target_strides : strides) used = used || target_strides[j] != 0;
-    const bool major = j == 0;
-    if (!used) {
-      if (!major) s << "  rest /= " << radices[j] << "UL;\n";
-      continue;
-    }
-    s << "  {\n    const ulong digit = " << (major ? "rest" : "rest % " + std::to_string(radices[j]) + "UL") << ";\n";
-    for (std::size_t t = 0; t < targets.size(); ++t)
-      if (strides[t][j]) s << "    " << targets[t] << " += digit * " << strides[t][j] << "UL;\n";
-    if (!major) s << "    rest /= " << radices[j] << "UL;\n";
-    s << "  }\n";
-  }
-}
-
-std::string kernel_head(std::size_t k) {
-  return "__kernel void stage" + std::to_string(k) +
-         "(__global const double* in, __global double* out, __global const uint* first,\n"
-         "    __global const uint* count, __global const double* masses, ulong in_offset, uint block_first,\n"
-         "    uint block_end, uint accumulate) {\n";
-}
-
-// The kept cells of the tuple's window that lie in the block of the contracted dimension held by
-// the input ([block_first, block_end): all of it, except in the last stage of a slice).
-void window_of_tuple(std::ostringstream& s, const FactoredStage& stage) {
-  s << "  const uint kept_first = first[tuple];\n"
-       "  const uint lo = max(kept_first, block_first);\n"
-       "  const uint hi = min(kept_first + count[tuple], block_end);\n"
-       "  const int cells = (int)hi - (int)lo;\n"
-    << "  __global const double* m = masses + tuple * " << stage.width << "UL + (lo - kept_first);\n"
-    << "  __global const double* v = in + in_index + (ulong)(lo - block_first) * " << stage.contracted_stride
-    << "UL;\n";
+// `sum`: one entry's FMA chain over its window's cells in order.
+void entry_sum(std::ostringstream& s, const FactoredStage& stage) {
+  s << "  const ulong tuple_a = tuple;\n";
+  window_of_tuple(s, stage, "_a", "  ");
+  s << "  __global const double* v = in + in_index + (ulong)(lo_a - block_first) * " << stage.contracted_stride
+    << "UL;\n  double sum = 0.0;\n"
+    << "  for (int c = 0; c < cells_a; ++c) sum = fma(m_a[c], v[(ulong)c * " << stage.contracted_stride
+    << "UL], sum);\n";
 }
 
 // One output entry per work-item (entries that share no masses or no contiguous values).
@@ -60,115 +31,42 @@ void scalar_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std:
     << "  if (entry >= " << stage.output_size << "UL) return;\n"
     << "  ulong in_index = in_offset, tuple = 0;\n";
   decode_digits(s, "entry", radices, {stage.input_stride, stage.tuple_stride}, {"in_index", "tuple"});
-  window_of_tuple(s, stage);
-  s << "  double sum = 0.0;\n"
-    << "  for (int c = 0; c < cells; ++c) sum = fma(m[c], v[(ulong)c * " << stage.contracted_stride << "UL], sum);\n"
-    << "  out[entry] = accumulate ? out[entry] + sum : sum;\n}\n\n";
+  entry_sum(s, stage);
+  s << "  out[entry] = accumulate ? out[entry] + sum : sum;\n}\n\n";
 }
 
-// Values the rows between two visits of the same block may read in output order for that block
-// to be still in a core's cache (the L2 of the CPUs measured: 512 KiB).
-constexpr double kRowReuseBytes = 512.0 * 1024;
-
-// SIMD rows: after the major digit (kept major: a team splits a stage's rows by it), the digits
-// that pick only masses (input stride 0) fastest, so that consecutive work-items of a group (run
-// one after another by a CPU thread) contract the same block of values with windows shifted by
-// a cell or so: the block stays in the core's cache instead of being fetched again after a pass
-// over every other block. Only where those passes outgrow the cache: otherwise output order
-// already reuses the blocks, and writes its rows' lanes (often a cache line apart) line by line.
-void order_rows_by_window(const FactoredStage& stage, std::uint64_t radix, std::vector<std::uint64_t>& radices,
-                          std::vector<std::uint64_t>& input_strides, std::vector<std::uint64_t>& tuple_strides,
-                          std::vector<std::uint64_t>& out_strides) {
-  double pass_bytes = double(stage.width) * double(radix) * sizeof(double);
-  for (std::size_t j = radices.size(); j-- > 1 && input_strides[j] != 0;) pass_bytes *= double(radices[j]);
-  if (pass_bytes <= kRowReuseBytes) return;
-  std::vector<std::size_t> order(radices.size());
-  for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
-  if (order.size() > 1)
-    std::stable_partition(order.begin() + 1, order.end(), [&](std::size_t j) { return input_strides[j] != 0; });
-  auto permuted = [&](const std::vector<std::uint64_t>& values) {
-    std::vector<std::uint64_t> result;
-    for (std::size_t j : order) result.push_back(values[j]);
-    return result;
-  };
-  radices = permuted(radices);
-  input_strides = permuted(input_strides);
-  tuple_strides = permuted(tuple_strides);
-  out_strides = permuted(out_strides);
-}
-
-// Entries along the vector digit share the tuple (masses, window) and read contiguous values.
-// SIMD devices: one work-item per row of the vector digit, LANES entries per vector load and FMA,
-// the row in chunks of LANES. SIMT devices: one work-item per entry (LANES 1), the vector digit
-// fastest, so that neighbouring work-items read neighbouring values. Either way each entry is
-// one FMA chain over its window cells in order: the same arithmetic as scalar_stage_kernel. The
-// last chunk of a row may read past the row (buffers have kTensorSlack cells after their end)
-// and stores only its valid lanes.
-void vector_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
+// One entry of the vector digit per work-item, that digit fastest, so that neighbouring
+// work-items read neighbouring values (SIMT devices): the same FMA chain as scalar_stage_kernel.
+void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k) {
   const std::size_t vector_digit = *stage.vector_digit;
-  const std::uint64_t radix = stage.output[vector_digit].radix;
-  const std::uint64_t lanes = shape.lanes(radix);
-  const std::uint64_t chunks = (radix + lanes - 1) / lanes;
-  std::vector<std::uint64_t> output_strides(stage.output.size());
-  std::uint64_t stride = 1;
-  for (std::size_t j = stage.output.size(); j-- > 0;) {
-    output_strides[j] = stride;
-    stride *= stage.output[j].radix;
-  }
-  // Work-item digits: the other output digits, then (SIMT) the chunk of the vector digit.
+  const std::vector<std::uint64_t> strides = output_strides(stage);
   std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides;
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
     if (j == vector_digit) continue;
     radices.push_back(stage.output[j].radix);
     input_strides.push_back(stage.input_stride[j]);
     tuple_strides.push_back(stage.tuple_stride[j]);
-    out_strides.push_back(output_strides[j]);
+    out_strides.push_back(strides[j]);
   }
-  const std::uint64_t lane_stride = output_strides[vector_digit];
-  if (shape.row_per_item) {
-    if (!shape.rows_in_output_order)
-      order_rows_by_window(stage, radix, radices, input_strides, tuple_strides, out_strides);
-  } else {
-    radices.push_back(chunks);
-    input_strides.push_back(lanes);
-    tuple_strides.push_back(0);
-    out_strides.push_back(lanes * lane_stride);
-  }
-  const std::string vector_type = lanes == 1 ? "double" : "double" + std::to_string(lanes);
-  const std::string load = lanes == 1 ? "*(v + (ulong)c * " + std::to_string(stage.contracted_stride) + "UL)"
-                                      : "vload" + std::to_string(lanes) + "(0, v + (ulong)c * " +
-                                            std::to_string(stage.contracted_stride) + "UL)";
+  radices.push_back(stage.output[vector_digit].radix);
+  input_strides.push_back(1);
+  tuple_strides.push_back(0);
+  out_strides.push_back(strides[vector_digit]);
   s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
-    << "  if (item >= " << stage_work_items(stage, shape) << "UL) return;\n"
+    << "  if (item >= " << stage.output_size << "UL) return;\n"
     << "  ulong in_index = in_offset, tuple = 0, out_index = 0;\n";
   decode_digits(s, "item", radices, {input_strides, tuple_strides, out_strides}, {"in_index", "tuple", "out_index"});
-  window_of_tuple(s, stage);
-  if (shape.row_per_item)
-    s << "  for (uint chunk = 0; chunk < " << chunks << "u; ++chunk, v += " << lanes << ", out_index += "
-      << lanes * lane_stride << "UL) {\n";
-  else
-    s << "  {\n    const uint chunk = (uint)(item % " << chunks << "UL);\n";
-  s << "    " << vector_type << " sum = 0.0;\n"
-    << "    for (int c = 0; c < cells; ++c) sum = fma((" << vector_type << ")(m[c]), " << load << ", sum);\n";
-  if (lanes == 1) {
-    s << "    out[out_index] = accumulate ? out[out_index] + sum : sum;\n";
-  } else {
-    s << "    const uint valid = min(" << lanes << "u, " << radix << "u - chunk * " << lanes << "u);\n"
-      << "    const double lane_sums[" << lanes << "] = {";
-    for (std::uint64_t lane = 0; lane < lanes; ++lane) s << (lane ? ", " : "") << "sum.s" << "01234567"[lane];
-    s << "};\n"
-      << "    for (uint lane = 0; lane < valid; ++lane) {\n"
-      << "      __global double* target = out + out_index + (ulong)lane * " << lane_stride << "UL;\n"
-      << "      *target = accumulate ? *target + lane_sums[lane] : lane_sums[lane];\n    }\n";
-  }
-  s << "  }\n}\n\n";
+  entry_sum(s, stage);
+  s << "  out[out_index] = accumulate ? out[out_index] + sum : sum;\n}\n\n";
 }
 
 void stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
-  if (stage.vector_digit)
-    vector_stage_kernel(s, stage, k, shape);
-  else
+  if (!stage.vector_digit)
     scalar_stage_kernel(s, stage, k);
+  else if (shape.row_per_item)
+    row_stage_kernel(s, stage, k, shape);
+  else
+    entry_stage_kernel(s, stage, k);
 }
 
 // Q's radices and strides of the variables of one space, in the variables' order.
@@ -269,14 +167,13 @@ StageShape stage_shape_for(unsigned native_double_width) {
   StageShape shape;
   shape.row_per_item = native_double_width > 1;
   shape.states_in_q_order = shape.row_per_item;
+  shape.native_double_width = native_double_width;
   return shape;
 }
 
 std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& shape) {
-  if (!stage.vector_digit) return stage.output_size;
-  const std::uint64_t radix = stage.output[*stage.vector_digit].radix, lanes = shape.lanes(radix);
-  const std::uint64_t rows = stage.output_size / radix;
-  return shape.row_per_item ? rows : rows * ((radix + lanes - 1) / lanes);
+  if (!stage.vector_digit || !shape.row_per_item) return stage.output_size;
+  return row_work_items(stage);
 }
 
 std::uint64_t choose_work_items(const Abstraction& abstraction, const StageShape& shape) {

@@ -1,0 +1,248 @@
+// Why two rows per work-item: on a CPU a row's contraction loads a vector of values per FMA, and
+// the loads, not the FMAs, bound it (the stage's values come from L2, a cache line or two per
+// vector). Two rows whose windows cover nearly the same cells of the same values (neighbouring
+// values of a digit that picks only masses: neighbouring states whose post coordinates lie a
+// fraction of a cell apart) load each vector once for two FMAs.
+#include "opencl/factored/row_kernel.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "opencl/factored/kernel_text.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+// The work-item digits of a row kernel: every output digit but the vector digit.
+struct ItemDigits {
+  std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides, pair_strides, tile_strides;
+};
+
+// Rows per work-item where the vector digit is not the output's fastest digit (a row's entries
+// lie a line or more apart): a line of neighbouring entries of the fastest digit, kept in private
+// memory and stored a line at a time instead of one entry per line.
+constexpr std::uint64_t kStoreTile = 8;
+
+// Values the rows between two visits of the same block may read in output order for that block
+// to be still in a core's cache (the L2 of the CPUs measured: 512 KiB).
+constexpr double kRowReuseBytes = 512.0 * 1024;
+
+// After the major digit (kept major: a team splits a stage's rows by it), the digits that pick
+// only masses (input stride 0) fastest, so that consecutive work-items of a group (run one after
+// another by a CPU thread) contract the same block of values with windows shifted by a cell or
+// so: the block stays in the core's cache instead of being fetched again after a pass over every
+// other block. Only where those passes outgrow the cache: otherwise output order already reuses
+// the blocks, and writes its rows' lanes (often a cache line apart) line by line.
+void order_rows_by_window(const FactoredStage& stage, std::uint64_t radix, ItemDigits& digits) {
+  double pass_bytes = double(stage.width) * double(radix) * sizeof(double);
+  for (std::size_t j = digits.radices.size(); j-- > 1 && digits.input_strides[j] != 0;)
+    pass_bytes *= double(digits.radices[j]) * double(digits.tile_strides[j] ? kStoreTile : 1);
+  if (pass_bytes <= kRowReuseBytes) return;
+  std::vector<std::size_t> order(digits.radices.size());
+  for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+  if (order.size() > 1)
+    std::stable_partition(order.begin() + 1, order.end(), [&](std::size_t j) { return digits.input_strides[j] != 0; });
+  for (auto* values :
+       {&digits.radices, &digits.input_strides, &digits.tuple_strides, &digits.out_strides, &digits.pair_strides,
+        &digits.tile_strides}) {
+    std::vector<std::uint64_t> permuted;
+    for (std::size_t j : order) permuted.push_back((*values)[j]);
+    *values = permuted;
+  }
+}
+
+// Doubles a work-item's accumulators may hold: 24 vector registers of 32 with AVX-512, 12 of 16
+// with AVX2 (the rest hold the masses and the addresses).
+std::uint64_t accumulator_doubles(unsigned native_double_width) {
+  return (native_double_width >= 8 ? 24 : 12) * std::uint64_t(native_double_width);
+}
+
+// One pass over cells [lo, hi) of the window per block of the row's chunks: per cell, the
+// block's stretch of the row (contiguous values) is loaded once, a vector per chunk, and added
+// with each named row's mass into that row's accumulators. Where the window's rows lie one after
+// another (the vector digit spans the contracted cell's stride), a block as wide as the row reads
+// the window in memory order: a stream the hardware prefetches. A row's mass outside its own
+// window is 0, and fma(0, v, s) == s for every finite v: each entry is the same FMA chain over
+// its own cells, in order, as one row alone would compute.
+struct RowPass {
+  const FactoredStage& stage;
+  std::uint64_t radix, lanes, lane_stride, accumulators;
+  std::string indent;
+  std::string in_index = "in_index";  ///< the rows' first value in the input
+  bool kept = false;                  ///< store into kept<row>[entry * kStoreTile + r], not out
+};
+void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std::string>& rows, const std::string& lo,
+              const std::string& hi) {
+  const std::uint64_t chunks = (pass.radix + pass.lanes - 1) / pass.lanes;
+  const std::uint64_t per_block = std::clamp<std::uint64_t>(pass.accumulators / rows.size(), 1, chunks);
+  const std::string vector_type = "double" + std::to_string(pass.lanes), in = pass.indent;
+  const bool alone = rows.size() == 1;
+  for (std::uint64_t first = 0; first < chunks; first += per_block) {
+    const std::uint64_t count = std::min(per_block, chunks - first);
+    s << in << "{\n";
+    for (const std::string& row : rows)
+      for (std::uint64_t j = 0; j < count; ++j) s << in << "  " << vector_type << " sum" << row << j << " = 0.0;\n";
+    s << in << "  __global const double* line = in + " << pass.in_index << " + (ulong)(" << lo << " - block_first) * "
+      << pass.stage.contracted_stride << "UL + " << first * pass.lanes << "UL;\n"
+      << in << "  for (uint c = " << lo << "; c < " << hi << "; ++c, line += " << pass.stage.contracted_stride
+      << "UL) {\n";
+    for (const std::string& row : rows)
+      s << in << "    const " << vector_type << " mass" << row << " = (" << vector_type << ")("
+        << (alone ? "m" + row + "[c - lo" + row + "]"
+                  : "c >= lo" + row + " && c < hi" + row + " ? m" + row + "[c - lo" + row + "] : 0.0")
+        << ");\n";
+    for (std::uint64_t j = 0; j < count; ++j) {
+      s << in << "    {\n" << in << "      const " << vector_type << " values = vload" << pass.lanes << "(" << j
+        << ", line);\n";
+      for (const std::string& row : rows)
+        s << in << "      sum" << row << j << " = fma(mass" << row << ", values, sum" << row << j << ");\n";
+      s << in << "    }\n";
+    }
+    s << in << "  }\n";
+    for (const std::string& row : rows)
+      for (std::uint64_t j = 0; j < count; ++j) {
+        const std::uint64_t chunk = first + j, valid = std::min(pass.lanes, pass.radix - chunk * pass.lanes);
+        for (std::uint64_t lane = 0; lane < valid; ++lane) {
+          const std::string value = "sum" + row + std::to_string(j) + ".s" + "01234567"[lane];
+          const std::uint64_t entry = chunk * pass.lanes + lane;
+          if (pass.kept)
+            s << in << "  kept" << row << "[" << entry * kStoreTile << " + r] = " << value << ";\n";
+          else
+            s << in << "  { __global double* target = out + out_index" << row << " + " << entry * pass.lane_stride
+              << "UL; *target = accumulate ? *target + " << value << " : " << value << "; }\n";
+        }
+      }
+    s << in << "}\n";
+  }
+}
+
+// The kernel's body after the digit decoding, with a paired digit: rows _a and (where the digit
+// has a second value) _b; one pass for both where their windows' union is at most 3/4 of their
+// cells together (nearly the same cells), else a pass each.
+void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple, std::uint64_t pair_tuple_stride) {
+  const std::string& in = pass.indent;
+  s << in << "const ulong tuple_a = " << tuple << ", tuple_b = " << tuple << " + (has_b ? " << pair_tuple_stride
+    << "UL : 0UL);\n";
+  window_of_tuple(s, pass.stage, "_a", in);
+  window_of_tuple(s, pass.stage, "_b", in);
+  s << in << "const uint lo_ab = min(lo_a, lo_b), hi_ab = max(hi_a, hi_b);\n"
+    << in << "if (has_b && 4 * (int)(hi_ab - lo_ab) <= 3 * (cells_a + cells_b)) {\n";
+  RowPass inner = pass;
+  inner.indent = in + "  ";
+  row_pass(s, inner, {"_a", "_b"}, "lo_ab", "hi_ab");
+  s << in << "} else {\n";
+  row_pass(s, inner, {"_a"}, "lo_a", "hi_a");
+  s << in << "  if (has_b) {\n";
+  inner.indent = in + "    ";
+  row_pass(s, inner, {"_b"}, "lo_b", "hi_b");
+  s << in << "  }\n" << in << "}\n";
+}
+
+// The rows of a work-item (one, or a pair) from tuple `tuple` and input index `pass.in_index`.
+void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple,
+               std::optional<std::uint64_t> pair_tuple_stride) {
+  if (pair_tuple_stride) {
+    paired_rows(s, pass, tuple, *pair_tuple_stride);
+    return;
+  }
+  s << pass.indent << "const ulong tuple_a = " << tuple << ";\n";
+  window_of_tuple(s, pass.stage, "_a", pass.indent);
+  row_pass(s, pass, {"_a"}, "lo_a", "hi_a");
+}
+
+}  // namespace
+
+std::optional<std::size_t> paired_digit(const FactoredStage& stage) {
+  std::optional<std::size_t> best;
+  for (std::size_t j = 0; j < stage.output.size(); ++j) {
+    if (stage.vector_digit == j || stage.input_stride[j] != 0 || stage.tuple_stride[j] == 0) continue;
+    if (stage.output[j].radix < 2) continue;
+    if (!best || stage.output[j].radix >= stage.output[*best].radix) best = j;
+  }
+  return best;
+}
+
+std::optional<std::size_t> tiled_digit(const FactoredStage& stage) {
+  const std::size_t last = stage.output.size() - 1;
+  if (stage.vector_digit == last || paired_digit(stage) == last || stage.output[last].radix <= 2) return std::nullopt;
+  return last;
+}
+
+std::uint64_t row_work_items(const FactoredStage& stage) {
+  std::uint64_t items = stage.output_size / stage.output[*stage.vector_digit].radix;
+  auto group = [&](std::optional<std::size_t> digit, std::uint64_t size) {
+    if (!digit) return;
+    const std::uint64_t radix = stage.output[*digit].radix;
+    items = items / radix * ((radix + size - 1) / size);
+  };
+  group(paired_digit(stage), 2);
+  group(tiled_digit(stage), kStoreTile);
+  return items;
+}
+
+void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
+  const std::size_t vector_digit = *stage.vector_digit;
+  const std::uint64_t radix = stage.output[vector_digit].radix;
+  const std::vector<std::uint64_t> strides = output_strides(stage);
+  const std::optional<std::size_t> paired = paired_digit(stage), tiled = tiled_digit(stage);
+  ItemDigits digits;
+  for (std::size_t j = 0; j < stage.output.size(); ++j) {
+    if (j == vector_digit) continue;
+    const std::uint64_t scale = paired == j ? 2 : tiled == j ? kStoreTile : 1;
+    digits.radices.push_back((stage.output[j].radix + scale - 1) / scale);
+    digits.input_strides.push_back(stage.input_stride[j] * scale);
+    digits.tuple_strides.push_back(stage.tuple_stride[j] * scale);
+    digits.out_strides.push_back(strides[j] * scale);
+    digits.pair_strides.push_back(paired == j ? 2 : 0);
+    digits.tile_strides.push_back(tiled == j ? kStoreTile : 0);
+  }
+  if (!shape.rows_in_output_order) order_rows_by_window(stage, radix, digits);
+  s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
+    << "  if (item >= " << row_work_items(stage) << "UL) return;\n"
+    << "  ulong in_index = in_offset, tuple = 0, out_index = 0, pair_first = 0, tile_first = 0;\n";
+  decode_digits(s, "item", digits.radices,
+                {digits.input_strides, digits.tuple_strides, digits.out_strides, digits.pair_strides,
+                 digits.tile_strides},
+                {"in_index", "tuple", "out_index", "pair_first", "tile_first"});
+  const std::vector<std::string> rows = paired ? std::vector<std::string>{"_a", "_b"} : std::vector<std::string>{"_a"};
+  s << "  const ulong out_index_a = out_index;\n";
+  if (paired)
+    s << "  const bool has_b = pair_first + 1 < " << stage.output[*paired].radix << "UL;\n"
+      << "  const ulong out_index_b = out_index + " << strides[*paired] << "UL;\n";
+  std::optional<std::uint64_t> pair_tuple_stride;
+  if (paired) pair_tuple_stride = stage.tuple_stride[*paired];
+  RowPass pass{stage, radix, shape.lanes(radix), strides[vector_digit],
+               accumulator_doubles(shape.native_double_width) / shape.lanes(radix), "  "};
+  if (!tiled) {
+    item_rows(s, pass, "tuple", pair_tuple_stride);
+    s << "}\n\n";
+    return;
+  }
+  for (const std::string& row : rows) s << "  double kept" << row << "[" << radix * kStoreTile << "];\n";
+  s << "  const uint tile_rows = min(" << kStoreTile << "u, " << stage.output[*tiled].radix
+    << "u - (uint)tile_first);\n"
+    << "  for (uint r = 0; r < tile_rows; ++r) {\n"
+    << "    const ulong tuple_r = tuple + (ulong)r * " << stage.tuple_stride[*tiled] << "UL;\n"
+    << "    const ulong in_index_r = in_index + (ulong)r * " << stage.input_stride[*tiled] << "UL;\n";
+  pass.indent = "    ";
+  pass.in_index = "in_index_r";
+  pass.kept = true;
+  item_rows(s, pass, "tuple_r", pair_tuple_stride);
+  s << "  }\n";
+  for (const std::string& row : rows) {
+    const std::string indent = row == "_b" ? "    " : "  ";
+    if (row == "_b") s << "  if (has_b) {\n";
+    s << indent << "for (uint entry = 0; entry < " << radix << "u; ++entry) {\n"
+      << indent << "  __global double* line = out + out_index" << row << " + (ulong)entry * " << strides[vector_digit]
+      << "UL;\n"
+      << indent << "  for (uint r = 0; r < tile_rows; ++r)\n"
+      << indent << "    line[r] = accumulate ? line[r] + kept" << row << "[entry * " << kStoreTile << "u + r] : kept"
+      << row << "[entry * " << kStoreTile << "u + r];\n"
+      << indent << "}\n";
+    if (row == "_b") s << "  }\n";
+  }
+  s << "}\n\n";
+}
+
+}  // namespace amytiss::detail
