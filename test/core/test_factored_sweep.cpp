@@ -211,7 +211,7 @@ BothShapes run_both_shapes(const Abstraction& a) {
   BothShapes both;
   both.rows = detail::synthesize_opencl(a, options, &both.rows_report);
   detail::OpenClEngineOptions entries_engine;
-  entries_engine.factored_entry_per_item = true;
+  entries_engine.factored_vector_width = 1;
   both.entries = detail::synthesize_opencl(a, options, &both.entries_report, entries_engine);
   return both;
 }

@@ -59,7 +59,7 @@ Policy run(const Abstraction& a, SweepChoice sweep, const std::vector<std::strin
   options.compute.devices = devices;
   options.compute.memory_fraction = memory_fraction;
   detail::OpenClEngineOptions engine;
-  engine.factored_entry_per_item = entry_per_item;
+  engine.factored_vector_width = entry_per_item ? 1 : 0;
   SynthesisReport local;
   return detail::synthesize_opencl(a, options, report ? report : &local, engine);
 }

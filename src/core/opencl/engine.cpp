@@ -113,7 +113,7 @@ Policy run_on_device(const Abstraction& a, const DeviceInfo& device, const std::
   if (!factored) return run_dense(a, device, session, options, engine_options, reporter);
   rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
   const FactoredRunContext run{&device, session.context.get(), session.queue.get(), engine_options.kernel_cache_dir,
-                               engine_options.factored_entry_per_item, options.profile};
+                               engine_options.factored_vector_width, options.profile};
   return run_factored_sweep(a, *factored, run, reporter);
 }
 

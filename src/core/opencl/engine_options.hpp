@@ -20,8 +20,10 @@ struct OpenClEngineOptions {
   /// Folder of the program binary cache; empty: $XDG_CACHE_HOME/amytiss/kernels or
   /// ~/.cache/amytiss/kernels; "-": no cache (always build from source).
   std::string kernel_cache_dir;
-  /// Factored sweep: one entry per work-item (the GPU shape) even on a SIMD device (tests).
-  bool factored_entry_per_item = false;
+  /// Factored sweep: the double vector width its kernels are generated for; 0: the device's
+  /// native width. 1 takes one entry per work-item (the GPU shape) even on a SIMD device; 4 the
+  /// row kernels of an AVX2 CPU on an AVX-512 one (tests).
+  unsigned factored_vector_width = 0;
 };
 
 }  // namespace amytiss::detail

@@ -77,8 +77,9 @@ std::vector<TeamMember> set_up_members(const Abstraction& a, const FactoredPlan&
   }
   for (std::size_t i = 0; i < members.size(); ++i) {
     TeamDevice& device = team.devices()[i];
-    StageShape shape = factored_stage_shape(device.info, engine_options.factored_entry_per_item);
+    StageShape shape = factored_stage_shape(device.info, engine_options.factored_vector_width);
     shape.rows_in_output_order = rows_in_output_order;
+    shape.split_by_team = true;
     shape.states_in_q_order = false;  // the input choice is split by states
     members[i].kernels = build_factored_kernels(a, plan, device.info, device.session.context.get(),
                                                 engine_options.kernel_cache_dir, shape, rep.notes);

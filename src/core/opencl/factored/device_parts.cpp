@@ -43,8 +43,8 @@ void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTa
   check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
 }
 
-StageShape factored_stage_shape(const DeviceInfo& device, bool entry_per_item) {
-  return stage_shape_for(entry_per_item ? 1 : device.native_double_width);
+StageShape factored_stage_shape(const DeviceInfo& device, unsigned vector_width) {
+  return stage_shape_for(vector_width > 0 ? vector_width : device.native_double_width);
 }
 
 FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,

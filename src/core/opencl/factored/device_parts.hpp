@@ -36,8 +36,9 @@ StagePlacement stage_placement(const Abstraction& abstraction, const FactoredPla
 void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
                          const StagePlacement& placement);
 
-/// The shape `device` wants (entry_per_item: the SIMT shape whatever the device).
-StageShape factored_stage_shape(const DeviceInfo& device, bool entry_per_item);
+/// The shape `device` wants, or (vector_width > 0) the shape of a device of that native double
+/// vector width (1: the SIMT shape).
+StageShape factored_stage_shape(const DeviceInfo& device, unsigned vector_width);
 /// A device's program of the plan (stage kernels, choose_inputs) in `shape`; a note says which.
 struct FactoredKernels {
   StageShape shape;

@@ -173,7 +173,7 @@ StageShape stage_shape_for(unsigned native_double_width) {
 
 std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& shape) {
   if (!stage.vector_digit || !shape.row_per_item) return stage.output_size;
-  return row_work_items(stage);
+  return row_work_items(stage, shape);
 }
 
 std::uint64_t choose_work_items(const Abstraction& abstraction, const StageShape& shape) {

@@ -29,6 +29,9 @@ struct StageShape {
   /// Input choice: true (SIMD devices) takes a run of states per work-item in Q's order, false
   /// one state per work-item (SIMT devices, and a team, which splits the choice by states).
   bool states_in_q_order = false;
+  /// Rows: a team splits the rows by the digits before the vector digit, which a work-item must
+  /// then not take two at a time (each device's part is one range of work-items).
+  bool split_by_team = false;
   /// The device's native double vector width (the row kernels' register budget follows it).
   unsigned native_double_width = 1;
   /// Entries per vector: 8, 4 or 2 by the digit's radix for rows, 1 for entries.

@@ -153,9 +153,10 @@ void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tu
 
 }  // namespace
 
-std::optional<std::size_t> paired_digit(const FactoredStage& stage) {
+std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageShape& shape) {
   std::optional<std::size_t> best;
-  for (std::size_t j = 0; j < stage.output.size(); ++j) {
+  const std::size_t first = shape.split_by_team ? *stage.vector_digit + 1 : 0;
+  for (std::size_t j = first; j < stage.output.size(); ++j) {
     if (stage.vector_digit == j || stage.input_stride[j] != 0 || stage.tuple_stride[j] == 0) continue;
     if (stage.output[j].radix < 2) continue;
     if (!best || stage.output[j].radix >= stage.output[*best].radix) best = j;
@@ -163,21 +164,21 @@ std::optional<std::size_t> paired_digit(const FactoredStage& stage) {
   return best;
 }
 
-std::optional<std::size_t> tiled_digit(const FactoredStage& stage) {
+std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape) {
   const std::size_t last = stage.output.size() - 1;
-  if (stage.vector_digit == last || paired_digit(stage) == last || stage.output[last].radix <= 2) return std::nullopt;
+  if (stage.vector_digit == last || paired_digit(stage, shape) == last || stage.output[last].radix <= 2) return std::nullopt;
   return last;
 }
 
-std::uint64_t row_work_items(const FactoredStage& stage) {
+std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape) {
   std::uint64_t items = stage.output_size / stage.output[*stage.vector_digit].radix;
   auto group = [&](std::optional<std::size_t> digit, std::uint64_t size) {
     if (!digit) return;
     const std::uint64_t radix = stage.output[*digit].radix;
     items = items / radix * ((radix + size - 1) / size);
   };
-  group(paired_digit(stage), 2);
-  group(tiled_digit(stage), kStoreTile);
+  group(paired_digit(stage, shape), 2);
+  group(tiled_digit(stage, shape), kStoreTile);
   return items;
 }
 
@@ -185,7 +186,7 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   const std::size_t vector_digit = *stage.vector_digit;
   const std::uint64_t radix = stage.output[vector_digit].radix;
   const std::vector<std::uint64_t> strides = output_strides(stage);
-  const std::optional<std::size_t> paired = paired_digit(stage), tiled = tiled_digit(stage);
+  const std::optional<std::size_t> paired = paired_digit(stage, shape), tiled = tiled_digit(stage, shape);
   ItemDigits digits;
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
     if (j == vector_digit) continue;
@@ -199,7 +200,7 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   }
   if (!shape.rows_in_output_order) order_rows_by_window(stage, radix, digits);
   s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
-    << "  if (item >= " << row_work_items(stage) << "UL) return;\n"
+    << "  if (item >= " << row_work_items(stage, shape) << "UL) return;\n"
     << "  ulong in_index = in_offset, tuple = 0, out_index = 0, pair_first = 0, tile_first = 0;\n";
   decode_digits(s, "item", digits.radices,
                 {digits.input_strides, digits.tuple_strides, digits.out_strides, digits.pair_strides,

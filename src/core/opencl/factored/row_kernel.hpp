@@ -14,14 +14,15 @@ namespace amytiss::detail {
 /// The output digit whose neighbouring values a row work-item takes two at a time: the digit that
 /// picks only masses (input stride 0) with the most values (the finest grid: the two windows are
 /// shifted least), ties to the faster digit; none when no such digit has two values or more.
-std::optional<std::size_t> paired_digit(const FactoredStage& stage);
+/// A team's shape (split_by_team) takes it after the vector digit only.
+std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageShape& shape);
 
 /// The output's fastest digit where it is not the vector digit (nor the paired digit) and has
 /// more than two values: a row work-item takes a line of its neighbouring values.
-std::optional<std::size_t> tiled_digit(const FactoredStage& stage);
+std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape);
 
 /// Work-items of a stage with a vector digit on a SIMD device: its rows, or its pairs of rows.
-std::uint64_t row_work_items(const FactoredStage& stage);
+std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape);
 
 /// Stage kernel `k` (a stage with a vector digit) for a SIMD device.
 void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape);

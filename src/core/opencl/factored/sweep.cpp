@@ -107,7 +107,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   SynthesisReport& report = reporter.report();
   auto phase_start = SteadyClock::now();
   FactoredKernels kernels = build_factored_kernels(a, plan, *run.device, run.context, run.kernel_cache_dir,
-                                                   factored_stage_shape(*run.device, run.entry_per_item), report.notes);
+                                                   factored_stage_shape(*run.device, run.vector_width), report.notes);
   reporter.phase(PhaseKind::KernelBuild, "kernel build", seconds_since(phase_start));
   reporter.reached(Phase::Setup);
 

@@ -17,7 +17,7 @@ struct FactoredRunContext {
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   std::string kernel_cache_dir;  ///< see build_program
-  bool entry_per_item = false;   ///< the SIMT shape whatever the device (tests)
+  unsigned vector_width = 0;     ///< of the kernels; 0: the device's (OpenClEngineOptions)
   bool profile = false;          ///< finish every kernel before its clock stops
 };
 

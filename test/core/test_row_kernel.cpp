@@ -1,0 +1,122 @@
+// The factored sweep's row kernels for SIMD devices (src/core/opencl/factored/row_kernel.*): which
+// digits a work-item takes two or a line at a time, and that the kernels of every register budget
+// give the bits of one entry per work-item on pocl.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/config.hpp"
+#include "execute.hpp"
+#include "host/factored_plan.hpp"
+#include "opencl/engine_options.hpp"
+#include "opencl/factored/program.hpp"
+#include "opencl/factored/row_kernel.hpp"
+#include "test_support.hpp"
+
+namespace amytiss {
+namespace {
+
+using test_support::from_yaml;
+using test_support::traffic_yaml;
+
+constexpr double kUnlimitedBudget = 1e12;
+
+detail::FactoredPlan traffic_plan(double eta) {
+  const Abstraction a = from_yaml(traffic_yaml(eta, 2));
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  EXPECT_TRUE(plan) << reason;
+  return *plan;
+}
+
+const detail::FactoredStage& stage_of(const detail::FactoredPlan& plan, std::size_t dimension) {
+  for (const detail::FactoredStage& stage : plan.stages)
+    if (stage.dimension == dimension) return stage;
+  ADD_FAILURE() << "no stage contracts x'" << dimension;
+  return plan.stages.front();
+}
+
+// The variable (plan.variables index) of an output digit.
+std::size_t variable_of(const detail::FactoredStage& stage, std::size_t digit) {
+  EXPECT_FALSE(stage.output[digit].post);
+  return stage.output[digit].id;
+}
+
+TEST(RowKernel, PairsTheFinestDigitThatPicksOnlyMassesAndTilesTheFastestDigit) {
+  // Traffic: x'0 = 0.64 x0 + 0.36 x2 + 6 u0. Its stage's output ends with x'2 (the vector digit)
+  // then x0 (the next stage's vector digit): rows lie a line apart, so x0 is tiled. Of the
+  // digits that pick only masses, x2 (21 values) is paired, not u0 (2 values).
+  const detail::FactoredPlan plan = traffic_plan(0.4);
+  const detail::StageShape cpu = detail::stage_shape_for(8);
+  const detail::FactoredStage& x0 = stage_of(plan, 0);
+  const auto paired = detail::paired_digit(x0, cpu);
+  const auto tiled = detail::tiled_digit(x0, cpu);
+  ASSERT_TRUE(paired);
+  ASSERT_TRUE(tiled);
+  EXPECT_EQ(variable_of(x0, *paired), 2u);
+  EXPECT_EQ(*tiled, x0.output.size() - 1);
+  EXPECT_EQ(variable_of(x0, *tiled), 0u);
+  // 21 rows of x2 in 11 pairs, 21 of x0 in 3 lines of up to 8.
+  const std::uint64_t rows = x0.output_size / x0.output[*x0.vector_digit].radix;
+  EXPECT_EQ(detail::row_work_items(x0, cpu), rows / 21 * 11 / 21 * 3);
+  EXPECT_EQ(detail::stage_work_items(x0, cpu), detail::row_work_items(x0, cpu));
+
+  // x'2 = 0.64 x2 + 0.36 x1 + 8 u1: its output ends with u1, the only digit that picks only
+  // masses, which is paired (its two windows lie 20 cells apart: the kernel takes a pass each)
+  // and so not tiled.
+  const detail::FactoredStage& x2 = stage_of(plan, 2);
+  ASSERT_TRUE(detail::paired_digit(x2, cpu));
+  EXPECT_EQ(*detail::paired_digit(x2, cpu), x2.output.size() - 1);
+  EXPECT_FALSE(detail::tiled_digit(x2, cpu));
+
+  // A team splits rows by the digits before the vector digit: x'0's x2 lies before it.
+  detail::StageShape team = cpu;
+  team.split_by_team = true;
+  const auto team_paired = detail::paired_digit(x0, team);
+  EXPECT_TRUE(!team_paired || *team_paired > *x0.vector_digit);
+  // The SIMT shape takes one entry per work-item: no rows.
+  EXPECT_EQ(detail::stage_work_items(x0, detail::stage_shape_for(1)), x0.output_size);
+}
+
+TEST(RowKernel, SmallerRegisterBudgetsTakeARowInMorePasses) {
+  const detail::FactoredPlan plan = traffic_plan(0.15);  // rows of 54: 7 vectors of 8
+  const Abstraction a = from_yaml(traffic_yaml(0.15, 2));
+  // AVX-512 (32 registers): a pair's 14 accumulators in one pass; AVX2 (16): 3 vectors per row.
+  const std::string wide = detail::factored_program_source(a, plan, detail::stage_shape_for(8));
+  const std::string narrow = detail::factored_program_source(a, plan, detail::stage_shape_for(4));
+  EXPECT_NE(wide.find("sum_b6 = fma"), std::string::npos);
+  EXPECT_EQ(narrow.find("sum_b6 = fma"), std::string::npos);
+  EXPECT_NE(narrow.find("sum_b2 = fma"), std::string::npos);
+}
+
+// Policies of the factored sweep on pocl with kernels for vector width `width` (1: one entry per
+// work-item).
+Policy factored_policy(const Abstraction& a, unsigned width) {
+  SynthesisOptions options;
+  options.compute.device = DeviceKind::Cpu;
+  options.compute.sweep = SweepChoice::Factored;
+  detail::OpenClEngineOptions engine;
+  engine.factored_vector_width = width;
+  SynthesisReport report;
+  return detail::synthesize_opencl(a, options, &report, engine);
+}
+
+TEST(RowKernel, EveryRegisterBudgetGivesTheBitsOfOneEntryPerWorkItem) {
+  // Traffic on 21 cells: pairs sharing a pass (x2 in x'0's stage, x1 in x'1's), pairs a pass each
+  // (u1 in x'2's), odd radices (a last pair of one row, a last line of 5 rows). Long rows: 101
+  // entries, 13 vectors, the last partial.
+  for (const std::string& yaml : {traffic_yaml(0.4, 3), test_support::long_rows_yaml()}) {
+    const Abstraction a = from_yaml(yaml);
+    const Policy entries = factored_policy(a, 1);
+    for (unsigned width : {2u, 4u, 8u}) {
+      const Policy rows = factored_policy(a, width);
+      EXPECT_EQ(rows.values, entries.values) << a.config.name << ", width " << width;
+      EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name << ", width " << width;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace amytiss
