@@ -51,6 +51,9 @@ struct PhaseReport {
   /// Operand bytes of the phase's kernels: values and records they load, entries they store (an
   /// upper bound of the memory traffic: caches serve much of it). 0 if not counted.
   double bytes = 0;
+  /// Memory bytes the phase cannot avoid: its input and output tensors read and written once
+  /// (factored stages). 0 if not counted: the roofline then takes the operand bytes.
+  double memory_bytes = 0;
   PhaseKind kind = PhaseKind::Other;
   /// Set up (device setup, kernel build): not part of the compute time.
   bool is_setup() const { return kind == PhaseKind::DeviceSetup || kind == PhaseKind::KernelBuild; }
@@ -93,6 +96,10 @@ struct SynthesisReport {
   /// 0 otherwise.
   double measured_bandwidth_bytes_per_second = 0;
   std::string bandwidth_basis;
+  /// With profile on an OpenCL device: bytes read per second from a buffer in cache (a core's
+  /// L2 on a CPU), and how. 0 otherwise.
+  double measured_cache_bytes_per_second = 0;
+  std::string cache_basis;
   std::size_t host_peak_bytes = 0;    ///< peak resident set of the process (VmHWM)
   std::vector<EngineNote> notes;      ///< engine and device choice, fallback, storage, chunking, ...
   /// Several devices or ranks (docs/scale_out.md): seconds spent exchanging the parts between

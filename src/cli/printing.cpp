@@ -119,32 +119,39 @@ namespace {
 // The time steps share one intensity: they are one row, their times summed; each breakdown
 // (kernel, stage) is a row of its own.
 void print_roofline(const SynthesisReport& report) {
-  const double peak = report.peak_multiply_adds_per_second, bandwidth = report.measured_bandwidth_bytes_per_second;
-  if (peak <= 0 || bandwidth <= 0) return;
-  std::printf("  bandwidth %.1f GB/s measured: %s\n", bandwidth / 1e9, report.bandwidth_basis.c_str());
-  // Caches serve part of the operand bytes: the intensity is a lower bound and a phase may beat its roof.
-  std::printf("roofline (bandwidth %.1f GB/s measured, peak %.0f GMAC/s; MAC/B over operand bytes, a lower "
-              "bound of the intensity: %% roof may pass 100):\n", bandwidth / 1e9, peak / 1e9);
-  std::printf("  %-33s %12s %12s %8s %12s %8s\n", "phase", "MAC/B", "roof GMAC/s", "bound", "GMAC/s", "% roof");
-  auto print_row = [&](const std::string& name, double multiply_adds, double bytes, double seconds) {
-    if (multiply_adds <= 0 || bytes <= 0 || seconds <= 0) return;
-    const RooflinePoint point = roofline_point(peak, bandwidth, multiply_adds, bytes, seconds);
-    std::printf("  %-33s %12.4g %12.3f %8s %12.3f %8.1f\n", name.c_str(), point.intensity, point.roof / 1e9,
-                to_string(point.bound).c_str(), point.achieved / 1e9, 100.0 * point.fraction_of_roof);
+  const RooflineDevice device{report.peak_multiply_adds_per_second, report.measured_bandwidth_bytes_per_second,
+                              report.measured_cache_bytes_per_second};
+  if (device.peak <= 0 || device.bandwidth <= 0) return;
+  std::printf("  bandwidth %.1f GB/s measured: %s\n", device.bandwidth / 1e9, report.bandwidth_basis.c_str());
+  if (device.cache_bandwidth > 0)
+    std::printf("  cache bandwidth %.1f GB/s measured: %s\n", device.cache_bandwidth / 1e9, report.cache_basis.c_str());
+  std::printf("roofline (peak %.0f GMAC/s; memory %.1f GB/s over the bytes a phase must move, its tensors once; "
+              "cache %.1f GB/s over the operands its kernels load; the lowest roof bounds it):\n",
+              device.peak / 1e9, device.bandwidth / 1e9, device.cache_bandwidth / 1e9);
+  std::printf("  %-33s %10s %10s %12s %8s %12s %8s\n", "phase", "MAC/B mem", "MAC/B ops", "roof GMAC/s", "bound",
+              "GMAC/s", "% roof");
+  auto print_row = [&](const std::string& name, const RooflineWork& work) {
+    if (work.multiply_adds <= 0 || work.operand_bytes <= 0 || work.seconds <= 0) return;
+    const RooflinePoint point = roofline_point(device, work);
+    std::printf("  %-33s %10.4g %10.4g %12.3f %8s %12.3f %8.1f\n", name.c_str(), point.memory_intensity,
+                point.operand_intensity, point.roof / 1e9, to_string(point.bound).c_str(), point.achieved / 1e9,
+                100.0 * point.fraction_of_roof);
   };
-  double step_multiply_adds = 0, step_bytes = 0, step_seconds = 0;
+  RooflineWork steps_work;
   std::size_t steps = 0;
   for (const auto& phase : report.phases) {
     if (phase.kind != PhaseKind::Step) continue;
-    step_multiply_adds += phase.multiply_adds;
-    step_bytes += phase.bytes;
-    step_seconds += phase.seconds;
+    steps_work.multiply_adds += phase.multiply_adds;
+    steps_work.operand_bytes += phase.bytes;
+    steps_work.memory_bytes += phase.memory_bytes;
+    steps_work.seconds += phase.seconds;
     ++steps;
   }
-  print_row("time steps (" + std::to_string(steps) + ")", step_multiply_adds, step_bytes, step_seconds);
+  print_row("time steps (" + std::to_string(steps) + ")", steps_work);
   for (const auto& phase : report.phases)
     if (phase.kind != PhaseKind::Step && !phase.is_setup())
-      print_row((phase.is_breakdown() ? "  " : "") + phase.name, phase.multiply_adds, phase.bytes, phase.seconds);
+      print_row((phase.is_breakdown() ? "  " : "") + phase.name,
+                {phase.multiply_adds, phase.bytes, phase.memory_bytes, phase.seconds});
 }
 
 }  // namespace

@@ -110,17 +110,23 @@ TEST_F(CliTest, ProfilePrintsThePhaseTable) {
   EXPECT_CONTAINS(result.out, "host peak (VmHWM)");
 }
 
-// On an OpenCL device the profile measures the bandwidth and prints the steps' roofline.
-TEST_F(CliTest, ProfileOnADevicePrintsTheMeasuredBandwidthAndTheRoofline) {
+// On an OpenCL device the profile measures the memory and cache bandwidths and prints the
+// roofline of the steps and of each stage.
+TEST_F(CliTest, ProfileOnADevicePrintsTheMeasuredBandwidthsAndTheRoofline) {
   const CommandResult result = synth("--config " + quote(kTinyConfig) + " --device cpu --quiet --profile");
   ASSERT_EQ(0, result.exit_code) << result.err;
   EXPECT_CONTAINS(result.out, "GB/s measured: copy of ");
-  EXPECT_CONTAINS(result.out, "roofline (bandwidth ");
-  const std::string row = "time steps (4) ";
-  const std::size_t at = result.out.find(row);
-  ASSERT_NE(std::string::npos, at) << result.out;
-  const std::string line = result.out.substr(at, result.out.find('\n', at) - at);
-  EXPECT_TRUE(line.find(" memory ") != std::string::npos || line.find(" compute ") != std::string::npos) << line;
+  EXPECT_CONTAINS(result.out, "cache bandwidth ");
+  const std::size_t roofline = result.out.find("roofline (peak ");
+  ASSERT_NE(std::string::npos, roofline) << result.out;
+  for (const std::string row : {"time steps (4) ", "stage 0 (x'0, all steps) "}) {
+    const std::size_t at = result.out.find(row, roofline);
+    ASSERT_NE(std::string::npos, at) << row << "\n" << result.out;
+    const std::string line = result.out.substr(at, result.out.find('\n', at) - at);
+    EXPECT_TRUE(line.find(" memory ") != std::string::npos || line.find(" cache ") != std::string::npos ||
+                line.find(" compute ") != std::string::npos)
+        << line;
+  }
 }
 
 TEST_F(CliTest, CompareReferencePrintsSpeedUpAndDifference) {

@@ -1,6 +1,6 @@
 // The factored sweep's row kernels for SIMD devices (src/core/opencl/factored/row_kernel.*): which
-// digits a work-item takes two or a line at a time, and that the kernels of every register budget
-// give the bits of one entry per work-item on pocl.
+// digits a work-item takes two or a line at a time, that the kernels of every register budget
+// give the bits of one entry per work-item on pocl, and the work the profile counts for them.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -11,8 +11,10 @@
 #include "execute.hpp"
 #include "host/factored_plan.hpp"
 #include "opencl/engine_options.hpp"
+#include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/program.hpp"
 #include "opencl/factored/row_kernel.hpp"
+#include "opencl/factored/tables.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {
@@ -22,6 +24,8 @@ using test_support::from_yaml;
 using test_support::traffic_yaml;
 
 constexpr double kUnlimitedBudget = 1e12;
+// Sums of up to millions of whole numbers in double, in different orders.
+constexpr double kCountTolerance = 1e-12;
 
 detail::FactoredPlan traffic_plan(double eta) {
   const Abstraction a = from_yaml(traffic_yaml(eta, 2));
@@ -89,6 +93,43 @@ TEST(RowKernel, SmallerRegisterBudgetsTakeARowInMorePasses) {
   EXPECT_NE(wide.find("sum_b6 = fma"), std::string::npos);
   EXPECT_EQ(narrow.find("sum_b6 = fma"), std::string::npos);
   EXPECT_NE(narrow.find("sum_b2 = fma"), std::string::npos);
+}
+
+// Multiply-adds, value loads and memory bytes of every stage of `plan`, summed over the stages.
+detail::StageWork total_work(const Abstraction& a, const detail::FactoredPlan& plan, const detail::StageShape& shape) {
+  const std::vector<detail::MassTable> tables = detail::factored_mass_tables(a, plan);
+  detail::StageWork total;
+  for (std::size_t k = 0; k < plan.stages.size(); ++k) {
+    const detail::StageWork work = detail::stage_work(a, plan, k, tables[plan.stages[k].dimension], shape);
+    EXPECT_GT(work.multiply_adds, 0.0);
+    EXPECT_LE(work.value_loads, work.multiply_adds);
+    EXPECT_GT(work.memory_bytes, 8.0 * double(plan.stages[k].output_size));
+    total.multiply_adds += work.multiply_adds;
+    total.value_loads += work.value_loads;
+  }
+  return total;
+}
+
+TEST(RowKernel, StageWorkCountsEveryCellOnceWhateverTheSlicesAndPairedRowsLoadOnce) {
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 2));
+  std::string reason;
+  const auto whole = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(whole) << reason;
+  const auto sliced = detail::plan_factored_sweep(a, double(whole->device_bytes) * 0.6, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(sliced) << reason;
+  ASSERT_GT(sliced->slices, 1u);
+  // A slice's stages contract its share of the tensors, and its last stage only the slice's cells
+  // of the last dimension: the multiply-adds of a step do not depend on the slices.
+  const detail::StageShape entries = detail::stage_shape_for(1), rows = detail::stage_shape_for(8);
+  const detail::StageWork once = total_work(a, *whole, entries), in_slices = total_work(a, *sliced, entries);
+  EXPECT_NEAR(in_slices.multiply_adds, once.multiply_adds, kCountTolerance * once.multiply_adds);
+  // One entry per work-item loads a value per multiply-add; pairs of rows that share a pass load
+  // each value once for both (x'0's x2 and x'1's x1 neighbours: windows a fraction of a cell apart).
+  EXPECT_NEAR(once.value_loads, once.multiply_adds, kCountTolerance * once.multiply_adds);
+  const detail::StageWork paired = total_work(a, *whole, rows);
+  EXPECT_NEAR(paired.multiply_adds, once.multiply_adds, kCountTolerance * once.multiply_adds);
+  EXPECT_LT(paired.value_loads, 0.7 * paired.multiply_adds);
+  EXPECT_GT(paired.value_loads, 0.5 * paired.multiply_adds);
 }
 
 // Policies of the factored sweep on pocl with kernels for vector width `width` (1: one entry per

@@ -16,7 +16,7 @@ StepReporter::StepReporter(const Abstraction& abstraction, const ProgressCallbac
       steps_start_(start_) {}
 
 void StepReporter::phase(PhaseKind kind, const std::string& name, double seconds, double pairs_per_second,
-                         double multiply_adds, double bytes) {
+                         double multiply_adds, double bytes, double memory_bytes) {
   PhaseReport phase;
   phase.kind = kind;
   phase.name = name;
@@ -24,6 +24,7 @@ void StepReporter::phase(PhaseKind kind, const std::string& name, double seconds
   phase.pairs_per_second = pairs_per_second;
   phase.multiply_adds = multiply_adds;
   phase.bytes = bytes;
+  phase.memory_bytes = memory_bytes;
   report_.phases.push_back(phase);
 }
 
@@ -36,11 +37,13 @@ void StepReporter::reached(Phase phase) {
   progress(phase, 0, abstraction_.unbounded ? 0 : abstraction_.horizon, -1);
 }
 
-void StepReporter::step_done(unsigned step, double seconds, double multiply_adds, double bytes) {
+void StepReporter::step_done(unsigned step, double seconds, double multiply_adds, double bytes,
+                             double memory_bytes) {
   // A step shorter than the clock's resolution still gets a finite rate.
   constexpr double kShortestStepSeconds = 1e-9;
   phase(PhaseKind::Step, "step " + std::to_string(step), seconds,
-        double(abstraction_.pairs()) / std::max(seconds, kShortestStepSeconds), multiply_adds, bytes);
+        double(abstraction_.pairs()) / std::max(seconds, kShortestStepSeconds), multiply_adds, bytes,
+        memory_bytes);
   const unsigned total = abstraction_.horizon, done = total - step;
   progress(done == total ? Phase::Done : Phase::Synthesis, done, total,
            seconds_since(steps_start_) / done * double(total - done));
@@ -90,7 +93,7 @@ Policy run_backward(const Abstraction& a, BellmanStep& step, StepReporter& repor
       const auto step_start = SteadyClock::now();
       step.apply_resident(&policy.values[std::size_t(k + 1) * cells], &policy.values[std::size_t(k) * cells],
                           &policy.input_index[std::size_t(k) * cells]);
-      reporter.step_done(k, seconds_since(step_start), step.multiply_adds(), step.bytes());
+      reporter.step_done(k, seconds_since(step_start), step.multiply_adds(), step.bytes(), step.memory_bytes());
     }
   }
   reporter.report().host_peak_bytes = peak_resident_bytes();

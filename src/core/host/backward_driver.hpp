@@ -26,7 +26,7 @@ class StepReporter {
 
   /// Appends a phase report (seconds; pairs per second where it applies).
   void phase(PhaseKind kind, const std::string& name, double seconds, double pairs_per_second = 0,
-             double multiply_adds = 0, double bytes = 0);
+             double multiply_adds = 0, double bytes = 0, double memory_bytes = 0);
   /// Progress at the end of set-up (Phase::Setup) or construction (Phase::Construction).
   void reached(Phase phase);
   /// Starts the clock of the time steps' estimate of the time left.
@@ -34,7 +34,7 @@ class StepReporter {
   /// After time step `step` (counting down from the horizon) that took `seconds` and did
   /// `multiply_adds` over operand `bytes`: its phase report and the progress, Phase::Done after
   /// the last one.
-  void step_done(unsigned step, double seconds, double multiply_adds, double bytes);
+  void step_done(unsigned step, double seconds, double multiply_adds, double bytes, double memory_bytes = 0);
   /// Unbounded specifications: progress after each interval iteration (no total: 0 %), and
   /// Phase::Done at the end.
   void iteration_done(unsigned iterations);

@@ -26,6 +26,8 @@ class BellmanStep {
   /// Multiply-adds of one apply() (0 when not counted), and operand bytes.
   virtual double multiply_adds() const { return 0; }
   virtual double bytes() const { return 0; }
+  /// Memory bytes one apply() cannot avoid (its tensors read and written once); 0 when not counted.
+  virtual double memory_bytes() const { return 0; }
   /// How far apart two of its values must be to differ by more than its arithmetic's rounding.
   virtual double resolution() const { return 1e-14; }
 };

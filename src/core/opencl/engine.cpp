@@ -108,6 +108,8 @@ Policy run_on_device(const Abstraction& a, const DeviceInfo& device, const std::
     const DeviceBandwidth bandwidth = measured_copy_bandwidth(device, session, engine_options.kernel_cache_dir);
     rep.measured_bandwidth_bytes_per_second = bandwidth.bytes_per_second;
     rep.bandwidth_basis = bandwidth.basis;
+    rep.measured_cache_bytes_per_second = bandwidth.cache_bytes_per_second;
+    rep.cache_basis = bandwidth.cache_basis;
   }
   reporter.phase(PhaseKind::DeviceSetup, "device setup", seconds_since(phase_start));
   if (!factored) return run_dense(a, device, session, options, engine_options, reporter);

@@ -191,8 +191,9 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
   std::vector<MassTable> tables;
   std::vector<TeamMember> members = set_up_members(a, plan, team, engine_options, tables, reporter);
   double multiply_adds_per_step = 0;
-  for (const FactoredStage& stage : plan.stages)
-    multiply_adds_per_step += stage_multiply_adds(stage, tables[stage.dimension], plan.slices);
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    multiply_adds_per_step +=
+        stage_work(a, plan, k, tables[plan.stages[k].dimension], members.front().kernels.shape).multiply_adds;
   FactoredTeamStep step(a, plan, team, members, multiply_adds_per_step);
   for (const std::string& line : team.describe(step.states(), "input choice, states"))
     reporter.report().notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});

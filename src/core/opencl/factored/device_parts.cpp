@@ -4,16 +4,58 @@
 #include <algorithm>
 #include <numeric>
 
+#include "opencl/factored/row_kernel.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/program_cache.hpp"
 
 namespace amytiss::detail {
 
-// Every tuple of the contracted dimension's table occurs output_size / tuples times per slice,
-// with its kept cells.
-double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, std::size_t slices) {
-  const double kept = std::accumulate(table.count.begin(), table.count.end(), 0.0);
-  return double(stage.output_size) * double(slices) / double(table.count.size()) * kept;
+StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t k, const MassTable& table,
+                     const StageShape& shape) {
+  const FactoredStage& stage = plan.stages[k];
+  std::optional<std::size_t> paired;
+  if (stage.vector_digit && shape.row_per_item) paired = paired_digit(stage, shape);
+  const std::size_t tuples = table.count.size();
+  // Per slice, every tuple's window clipped to the block the input holds, as the kernels clip it.
+  auto window = [&](std::size_t tuple, const StagePlacement& placement) {
+    const long long lo = std::max<long long>(table.first[tuple], placement.lo);
+    const long long hi = std::max<long long>(lo, std::min<long long>(table.first[tuple] + table.count[tuple], placement.hi));
+    return std::pair<long long, long long>{lo, hi};
+  };
+  double cells = 0, loads = 0;
+  for (std::size_t slice = 0; slice < plan.slices; ++slice) {
+    const StagePlacement placement = stage_placement(a, plan, k, slice);
+    for (std::size_t tuple = 0; tuple < tuples; ++tuple) {
+      const auto [lo_a, hi_a] = window(tuple, placement);
+      cells += double(hi_a - lo_a);
+      if (!paired) {
+        loads += double(hi_a - lo_a);
+        continue;
+      }
+      const std::uint64_t stride = stage.tuple_stride[*paired], radix = stage.output[*paired].radix;
+      const std::uint64_t value = tuple / stride % radix;
+      if (value % 2 == 1) continue;  // counted with its pair's first row
+      if (value + 1 == radix) {
+        loads += double(hi_a - lo_a);
+        continue;
+      }
+      const auto [lo_b, hi_b] = window(tuple + stride, placement);
+      const long long union_cells = std::max(hi_a, hi_b) - std::min(lo_a, lo_b);
+      const long long apart = (hi_a - lo_a) + (hi_b - lo_b);
+      loads += double(rows_share_pass(union_cells, hi_a - lo_a, hi_b - lo_b) ? union_cells : apart);
+    }
+  }
+  // Every tuple occurs output_size / tuples times in a slice's output.
+  const double uses = double(stage.output_size) / double(tuples);
+  StageWork work;
+  work.multiply_adds = uses * cells;
+  work.value_loads = uses * loads;
+  // The input is read at most once, and at most as often as the kernels load values (windows that
+  // cover part of the contracted cells leave the rest unread).
+  const double input = k == 0 ? double(a.states.size()) / double(plan.slices) : double(plan.stages[k - 1].output_size);
+  work.memory_bytes = 8.0 * (std::min(double(plan.slices) * input, work.value_loads) +
+                             double(plan.slices) * double(stage.output_size));
+  return work;
 }
 
 StagePlacement stage_placement(const Abstraction& a, const FactoredPlan& plan, std::size_t k, std::size_t slice) {

@@ -19,8 +19,18 @@ struct DeviceTable {
   Buffer first, count, masses;
 };
 struct MassTable;
-/// Multiply-adds stage `stage` does over all slices of one time step.
-double stage_multiply_adds(const FactoredStage& stage, const MassTable& table, std::size_t slices);
+/// What stage k does in one time step, all slices together, with `shape`'s kernels.
+struct StageWork {
+  double multiply_adds = 0;
+  /// Values its kernels load: a value per multiply-add, except where a pair of rows loads each
+  /// value once for both (row_kernel.hpp).
+  double value_loads = 0;
+  /// Its input read once per slice (at most as often as values are loaded) and its output written
+  /// once per slice, in bytes.
+  double memory_bytes = 0;
+};
+StageWork stage_work(const Abstraction& abstraction, const FactoredPlan& plan, std::size_t k, const MassTable& table,
+                     const StageShape& shape);
 /// Where stage k of slice `slice` reads and writes: the input's offset (first stage of a slice
 /// reads the slice out of V), the block [lo, hi) of the contracted dimension that the input holds
 /// (the last stage contracts the slice's cells only), and whether to add to the output (later

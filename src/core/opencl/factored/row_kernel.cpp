@@ -118,8 +118,8 @@ void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std:
 }
 
 // The kernel's body after the digit decoding, with a paired digit: rows _a and (where the digit
-// has a second value) _b; one pass for both where their windows' union is at most 3/4 of their
-// cells together (nearly the same cells), else a pass each.
+// has a second value) _b; one pass for both where rows_share_pass (nearly the same cells), else a
+// pass each.
 void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple, std::uint64_t pair_tuple_stride) {
   const std::string& in = pass.indent;
   s << in << "const ulong tuple_a = " << tuple << ", tuple_b = " << tuple << " + (has_b ? " << pair_tuple_stride
@@ -127,7 +127,8 @@ void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& 
   window_of_tuple(s, pass.stage, "_a", in);
   window_of_tuple(s, pass.stage, "_b", in);
   s << in << "const uint lo_ab = min(lo_a, lo_b), hi_ab = max(hi_a, hi_b);\n"
-    << in << "if (has_b && 4 * (int)(hi_ab - lo_ab) <= 3 * (cells_a + cells_b)) {\n";
+    << in << "if (has_b && 4 * (int)(hi_ab - lo_ab) <= 3 * (cells_a + cells_b)) {  // rows_share_pass\n";
+  static_assert(rows_share_pass(3, 2, 2) && !rows_share_pass(4, 2, 3), "the kernel's rule, 4 union <= 3 cells");
   RowPass inner = pass;
   inner.indent = in + "  ";
   row_pass(s, inner, {"_a", "_b"}, "lo_ab", "hi_ab");

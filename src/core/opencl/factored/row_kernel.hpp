@@ -21,6 +21,12 @@ std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageS
 /// more than two values: a row work-item takes a line of its neighbouring values.
 std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape);
 
+/// Whether a pair of rows takes one pass over the union of its windows (cells [lo, hi) each,
+/// clipped to the block): where the union is at most 3/4 of their cells together.
+constexpr bool rows_share_pass(long long union_cells, long long cells_a, long long cells_b) {
+  return 4 * union_cells <= 3 * (cells_a + cells_b);
+}
+
 /// Work-items of a stage with a vector digit on a SIMD device: its rows, or its pairs of rows.
 std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape);
 

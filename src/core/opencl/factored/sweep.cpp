@@ -20,14 +20,17 @@ class FactoredStep : public BellmanStep {
                FactoredKernels& kernels, FactoredBuffers& buffers, const std::vector<MassTable>& tables)
       : a_(a), plan_(plan), run_(run), kernels_(kernels), buffers_(buffers),
         group_(factored_group_size(*run.device)), seconds_(plan.stages.size() + 1, 0.0),
-        multiply_adds_(plan.stages.size() + 1, 0.0), bytes_(plan.stages.size() + 1, 0.0) {
-    // Operand bytes: a value (double) per multiply-add, an entry stored per output; the input
-    // choice loads Q and stores a value and an input per state.
+        multiply_adds_(plan.stages.size() + 1, 0.0), bytes_(plan.stages.size() + 1, 0.0),
+        memory_bytes_(plan.stages.size() + 1, 0.0) {
+    // Operand bytes: the values the kernels load (doubles), an entry stored per output; the input
+    // choice loads Q and stores a value and an input per state, all of it memory traffic.
     for (std::size_t k = 0; k < plan.stages.size(); ++k) {
-      multiply_adds_[k] = stage_multiply_adds(plan.stages[k], tables[plan.stages[k].dimension], plan.slices);
-      bytes_[k] = 8.0 * (multiply_adds_[k] + double(plan.stages[k].output_size) * double(plan.slices));
+      const StageWork work = stage_work(a, plan, k, tables[plan.stages[k].dimension], kernels.shape);
+      multiply_adds_[k] = work.multiply_adds;
+      bytes_[k] = 8.0 * (work.value_loads + double(plan.stages[k].output_size) * double(plan.slices));
+      memory_bytes_[k] = work.memory_bytes;
     }
-    bytes_.back() = 8.0 * double(plan.q_size) + 12.0 * double(a.states.size());
+    bytes_.back() = memory_bytes_.back() = 8.0 * double(plan.q_size) + 12.0 * double(a.states.size());
   }
 
   void apply(const double* in, double* out, std::uint32_t* chosen) override {
@@ -39,6 +42,7 @@ class FactoredStep : public BellmanStep {
   void apply_resident(const double*, double* out, std::uint32_t* chosen) override;
   double multiply_adds() const override { return sum(multiply_adds_); }
   double bytes() const override { return sum(bytes_); }
+  double memory_bytes() const override { return sum(memory_bytes_); }
 
   // The profile's breakdown: every stage's and the input choice's time over `steps` steps.
   void report_breakdown(StepReporter& reporter, unsigned steps) const {
@@ -46,7 +50,8 @@ class FactoredStep : public BellmanStep {
       const std::string name = k < plan_.stages.size() ? "stage " + std::to_string(k) + " (x'" +
                                                              std::to_string(plan_.stages[k].dimension) + ", all steps)"
                                                        : "input choice (all steps)";
-      reporter.phase(PhaseKind::Breakdown, name, seconds_[k], 0, multiply_adds_[k] * steps, bytes_[k] * steps);
+      reporter.phase(PhaseKind::Breakdown, name, seconds_[k], 0, multiply_adds_[k] * steps, bytes_[k] * steps,
+                     memory_bytes_[k] * steps);
     }
   }
 
@@ -71,7 +76,7 @@ class FactoredStep : public BellmanStep {
   FactoredKernels& kernels_;
   FactoredBuffers& buffers_;
   std::size_t group_;
-  std::vector<double> seconds_, multiply_adds_, bytes_;
+  std::vector<double> seconds_, multiply_adds_, bytes_, memory_bytes_;
   int current_ = 0;
 };
 
