@@ -64,7 +64,8 @@ Policy terminal_policy(const Abstraction& a, const std::string& computed_by) {
   const std::size_t cells = a.states.size();
   policy.values.assign((std::size_t(a.horizon) + 1) * cells, 0.0);
   policy.input_index.assign(std::size_t(a.horizon) * cells, 0);
-  for (std::size_t x = 0; x < cells; ++x) policy.values[std::size_t(a.horizon) * cells + x] = a.terminal_value(a.roles[x]);
+  for (std::size_t x = 0; x < cells; ++x)
+    policy.values[std::size_t(a.horizon) * cells + x] = a.terminal_value(a.roles[x]);
   return policy;
 }
 

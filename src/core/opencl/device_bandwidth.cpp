@@ -112,7 +112,8 @@ DeviceBandwidth measure(const DeviceInfo& device, const DeviceSession& session, 
   DeviceBandwidth bandwidth;
   {
     const Kernel copy = create_kernel(program.get(), "copy_doubles");
-    const Buffer from = device_buffer(session, CL_MEM_READ_ONLY, bytes), to = device_buffer(session, CL_MEM_WRITE_ONLY, bytes);
+    const Buffer from = device_buffer(session, CL_MEM_READ_ONLY, bytes);
+    const Buffer to = device_buffer(session, CL_MEM_WRITE_ONLY, bytes);
     cl_mem from_handle = from.get(), to_handle = to.get();
     check(clSetKernelArg(copy.get(), 0, sizeof from_handle, &from_handle), "clSetKernelArg");
     check(clSetKernelArg(copy.get(), 1, sizeof to_handle, &to_handle), "clSetKernelArg");

@@ -19,7 +19,8 @@ StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t
   // Per slice, every tuple's window clipped to the block the input holds, as the kernels clip it.
   auto window = [&](std::size_t tuple, const StagePlacement& placement) {
     const long long lo = std::max<long long>(table.first[tuple], placement.lo);
-    const long long hi = std::max<long long>(lo, std::min<long long>(table.first[tuple] + table.count[tuple], placement.hi));
+    const long long end = std::min<long long>(table.first[tuple] + table.count[tuple], placement.hi);
+    const long long hi = std::max(lo, end);
     return std::pair<long long, long long>{lo, hi};
   };
   double cells = 0, loads = 0;

@@ -140,7 +140,8 @@ void choose_inputs_kernel(std::ostringstream& s, const Abstraction& a, const Fac
   const std::uint64_t run = radices.back(), run_q_stride = q_strides.back();
   std::vector<std::size_t> order(radices.size() - 1);
   for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return q_strides[i] > q_strides[j]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t i, std::size_t j) { return q_strides[i] > q_strides[j]; });
   std::vector<std::uint64_t> item_radices, item_q_strides, item_state_strides;
   for (std::size_t j : order) {
     item_radices.push_back(radices[j]);

@@ -120,7 +120,8 @@ void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std:
 // The kernel's body after the digit decoding, with a paired digit: rows _a and (where the digit
 // has a second value) _b; one pass for both where rows_share_pass (nearly the same cells), else a
 // pass each.
-void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple, std::uint64_t pair_tuple_stride) {
+void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple,
+                 std::uint64_t pair_tuple_stride) {
   const std::string& in = pass.indent;
   s << in << "const ulong tuple_a = " << tuple << ", tuple_b = " << tuple << " + (has_b ? " << pair_tuple_stride
     << "UL : 0UL);\n";
@@ -167,7 +168,8 @@ std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageS
 
 std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape) {
   const std::size_t last = stage.output.size() - 1;
-  if (stage.vector_digit == last || paired_digit(stage, shape) == last || stage.output[last].radix <= 2) return std::nullopt;
+  if (stage.vector_digit == last || paired_digit(stage, shape) == last || stage.output[last].radix <= 2)
+    return std::nullopt;
   return last;
 }
 

@@ -89,7 +89,8 @@ void FactoredStep::apply_resident(const double*, double* out, std::uint32_t* cho
       cl_mem stage_out = k == last_stage ? buffers_.q.get() : buffers_.stage_tensors[k % 2].get();
       // The first stage reads the slice out of V; the last contracts the slice's cells only.
       cl_kernel kernel = kernels_.stages[k].get();
-      set_stage_arguments(kernel, in, stage_out, buffers_.tables[stage.dimension], stage_placement(a_, plan_, k, slice));
+      set_stage_arguments(kernel, in, stage_out, buffers_.tables[stage.dimension],
+                          stage_placement(a_, plan_, k, slice));
       launch(kernel, stage_work_items(stage, kernels_.shape), k);
     }
   }
