@@ -58,13 +58,7 @@ std::uint64_t accumulator_doubles(unsigned native_double_width) {
   return (native_double_width >= 8 ? 24 : 12) * std::uint64_t(native_double_width);
 }
 
-// One pass over cells [lo, hi) of the window per block of the row's chunks: per cell, the
-// block's stretch of the row (contiguous values) is loaded once, a vector per chunk, and added
-// with each named row's mass into that row's accumulators. Where the window's rows lie one after
-// another (the vector digit spans the contracted cell's stride), a block as wide as the row reads
-// the window in memory order: a stream the hardware prefetches. A row's mass outside its own
-// window is 0, and fma(0, v, s) == s for every finite v: each entry is the same FMA chain over
-// its own cells, in order, as one row alone would compute.
+// What the passes of a row kernel share: the stage, the row's shape and where results go.
 struct RowPass {
   const FactoredStage& stage;
   std::uint64_t radix, lanes, lane_stride, accumulators;
@@ -72,6 +66,13 @@ struct RowPass {
   std::string in_index = "in_index";  ///< the rows' first value in the input
   bool kept = false;                  ///< store into kept<row>[entry * kStoreTile + r], not out
 };
+// One pass over cells [lo, hi) of the window per block of the row's chunks: per cell, the
+// block's stretch of the row (contiguous values) is loaded once, a vector per chunk, and added
+// with each named row's mass into that row's accumulators. Where the window's rows lie one after
+// another (the vector digit spans the contracted cell's stride), a block as wide as the row reads
+// the window in memory order: a stream the hardware prefetches. A row's mass outside its own
+// window is 0, and fma(0, v, s) == s for every finite v: each entry is the same FMA chain over
+// its own cells, in order, as one row alone would compute.
 void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std::string>& rows, const std::string& lo,
               const std::string& hi) {
   const std::uint64_t chunks = (pass.radix + pass.lanes - 1) / pass.lanes;
@@ -128,8 +129,8 @@ void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& 
   window_of_tuple(s, pass.stage, "_a", in);
   window_of_tuple(s, pass.stage, "_b", in);
   s << in << "const uint lo_ab = min(lo_a, lo_b), hi_ab = max(hi_a, hi_b);\n"
-    << in << "if (has_b && 4 * (int)(hi_ab - lo_ab) <= 3 * (cells_a + cells_b)) {  // rows_share_pass\n";
-  static_assert(rows_share_pass(3, 2, 2) && !rows_share_pass(4, 2, 3), "the kernel's rule, 4 union <= 3 cells");
+    << in << "if (has_b && " << kShareUnionWeight << " * (int)(hi_ab - lo_ab) <= " << kShareCellsWeight
+    << " * (cells_a + cells_b)) {\n";
   RowPass inner = pass;
   inner.indent = in + "  ";
   row_pass(s, inner, {"_a", "_b"}, "lo_ab", "hi_ab");
@@ -151,6 +152,37 @@ void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tu
   s << pass.indent << "const ulong tuple_a = " << tuple << ";\n";
   window_of_tuple(s, pass.stage, "_a", pass.indent);
   row_pass(s, pass, {"_a"}, "lo_a", "hi_a");
+}
+
+
+// A line of kStoreTile rows along digit `tiled` (the output's fastest), each row (or pair) into
+// private memory, then the line's entries stored side by side.
+void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, const std::vector<std::string>& rows,
+                std::optional<std::uint64_t> pair_tuple_stride) {
+  const FactoredStage& stage = pass.stage;
+  for (const std::string& row : rows) s << "  double kept" << row << "[" << pass.radix * kStoreTile << "];\n";
+  s << "  const uint tile_rows = min(" << kStoreTile << "u, " << stage.output[tiled].radix
+    << "u - (uint)tile_first);\n"
+    << "  for (uint r = 0; r < tile_rows; ++r) {\n"
+    << "    const ulong tuple_r = tuple + (ulong)r * " << stage.tuple_stride[tiled] << "UL;\n"
+    << "    const ulong in_index_r = in_index + (ulong)r * " << stage.input_stride[tiled] << "UL;\n";
+  pass.indent = "    ";
+  pass.in_index = "in_index_r";
+  pass.kept = true;
+  item_rows(s, pass, "tuple_r", pair_tuple_stride);
+  s << "  }\n";
+  for (const std::string& row : rows) {
+    const std::string indent = row == "_b" ? "    " : "  ";
+    if (row == "_b") s << "  if (has_b) {\n";
+    s << indent << "for (uint entry = 0; entry < " << pass.radix << "u; ++entry) {\n"
+      << indent << "  __global double* line = out + out_index" << row << " + (ulong)entry * " << pass.lane_stride
+      << "UL;\n"
+      << indent << "  for (uint r = 0; r < tile_rows; ++r)\n"
+      << indent << "    line[r] = accumulate ? line[r] + kept" << row << "[entry * " << kStoreTile << "u + r] : kept"
+      << row << "[entry * " << kStoreTile << "u + r];\n"
+      << indent << "}\n";
+    if (row == "_b") s << "  }\n";
+  }
 }
 
 }  // namespace
@@ -218,34 +250,10 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   if (paired) pair_tuple_stride = stage.tuple_stride[*paired];
   RowPass pass{stage, radix, shape.lanes(radix), strides[vector_digit],
                accumulator_doubles(shape.native_double_width) / shape.lanes(radix), "  "};
-  if (!tiled) {
+  if (tiled)
+    tiled_rows(s, pass, *tiled, rows, pair_tuple_stride);
+  else
     item_rows(s, pass, "tuple", pair_tuple_stride);
-    s << "}\n\n";
-    return;
-  }
-  for (const std::string& row : rows) s << "  double kept" << row << "[" << radix * kStoreTile << "];\n";
-  s << "  const uint tile_rows = min(" << kStoreTile << "u, " << stage.output[*tiled].radix
-    << "u - (uint)tile_first);\n"
-    << "  for (uint r = 0; r < tile_rows; ++r) {\n"
-    << "    const ulong tuple_r = tuple + (ulong)r * " << stage.tuple_stride[*tiled] << "UL;\n"
-    << "    const ulong in_index_r = in_index + (ulong)r * " << stage.input_stride[*tiled] << "UL;\n";
-  pass.indent = "    ";
-  pass.in_index = "in_index_r";
-  pass.kept = true;
-  item_rows(s, pass, "tuple_r", pair_tuple_stride);
-  s << "  }\n";
-  for (const std::string& row : rows) {
-    const std::string indent = row == "_b" ? "    " : "  ";
-    if (row == "_b") s << "  if (has_b) {\n";
-    s << indent << "for (uint entry = 0; entry < " << radix << "u; ++entry) {\n"
-      << indent << "  __global double* line = out + out_index" << row << " + (ulong)entry * " << strides[vector_digit]
-      << "UL;\n"
-      << indent << "  for (uint r = 0; r < tile_rows; ++r)\n"
-      << indent << "    line[r] = accumulate ? line[r] + kept" << row << "[entry * " << kStoreTile << "u + r] : kept"
-      << row << "[entry * " << kStoreTile << "u + r];\n"
-      << indent << "}\n";
-    if (row == "_b") s << "  }\n";
-  }
   s << "}\n\n";
 }
 

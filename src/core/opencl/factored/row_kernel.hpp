@@ -22,9 +22,11 @@ std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageS
 std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape);
 
 /// Whether a pair of rows takes one pass over the union of its windows (cells [lo, hi) each,
-/// clipped to the block): where the union is at most 3/4 of their cells together.
+/// clipped to the block): where the union is at most 3/4 of their cells together
+/// (kShareUnionWeight x union <= kShareCellsWeight x cells; the kernels test the same).
+constexpr long long kShareUnionWeight = 4, kShareCellsWeight = 3;
 constexpr bool rows_share_pass(long long union_cells, long long cells_a, long long cells_b) {
-  return 4 * union_cells <= 3 * (cells_a + cells_b);
+  return kShareUnionWeight * union_cells <= kShareCellsWeight * (cells_a + cells_b);
 }
 
 /// Work-items of a stage with a vector digit on a SIMD device: its rows, or its pairs of rows.
