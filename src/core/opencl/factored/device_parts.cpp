@@ -2,7 +2,8 @@
 #include "opencl/factored/device_parts.hpp"
 
 #include <algorithm>
-#include <numeric>
+#include <optional>
+#include <utility>
 
 #include "opencl/factored/row_kernel.hpp"
 #include "opencl/factored/tables.hpp"
