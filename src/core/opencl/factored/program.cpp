@@ -23,35 +23,21 @@ void entry_sum(std::ostringstream& s, const FactoredStage& stage) {
     << "UL], sum);\n";
 }
 
-// One output entry per work-item (entries that share no masses or no contiguous values).
-void scalar_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k) {
-  std::vector<std::uint64_t> radices;
-  for (const TensorDigit& digit : stage.output) radices.push_back(digit.radix);
-  s << kernel_head(k) << "  const ulong entry = get_global_id(0);\n"
-    << "  if (entry >= " << stage.output_size << "UL) return;\n"
-    << "  ulong in_index = in_offset, tuple = 0;\n";
-  decode_digits(s, "entry", radices, {stage.input_stride, stage.tuple_stride}, {"in_index", "tuple"});
-  entry_sum(s, stage);
-  s << "  out[entry] = accumulate ? out[entry] + sum : sum;\n}\n\n";
-}
-
-// One entry of the vector digit per work-item, that digit fastest, so that neighbouring
-// work-items read neighbouring values (SIMT devices): the same FMA chain as scalar_stage_kernel.
+// One output entry per work-item; the vector digit (if any) fastest, so that neighbouring
+// work-items read neighbouring values (SIMT devices, and stages without a vector digit).
 void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k) {
-  const std::size_t vector_digit = *stage.vector_digit;
   const std::vector<std::uint64_t> strides = output_strides(stage);
+  std::vector<std::size_t> order;
+  for (std::size_t j = 0; j < stage.output.size(); ++j)
+    if (stage.vector_digit != j) order.push_back(j);
+  if (stage.vector_digit) order.push_back(*stage.vector_digit);
   std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides;
-  for (std::size_t j = 0; j < stage.output.size(); ++j) {
-    if (j == vector_digit) continue;
+  for (std::size_t j : order) {
     radices.push_back(stage.output[j].radix);
     input_strides.push_back(stage.input_stride[j]);
     tuple_strides.push_back(stage.tuple_stride[j]);
     out_strides.push_back(strides[j]);
   }
-  radices.push_back(stage.output[vector_digit].radix);
-  input_strides.push_back(1);
-  tuple_strides.push_back(0);
-  out_strides.push_back(strides[vector_digit]);
   s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
     << "  if (item >= " << stage.output_size << "UL) return;\n"
     << "  ulong in_index = in_offset, tuple = 0, out_index = 0;\n";
@@ -61,9 +47,7 @@ void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::
 }
 
 void stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
-  if (!stage.vector_digit)
-    scalar_stage_kernel(s, stage, k);
-  else if (shape.row_per_item)
+  if (stage.vector_digit && shape.row_per_item)
     row_stage_kernel(s, stage, k, shape);
   else
     entry_stage_kernel(s, stage, k);
@@ -158,11 +142,6 @@ void choose_inputs_kernel(std::ostringstream& s, const Abstraction& a, const Fac
 }
 
 }  // namespace
-
-std::uint64_t StageShape::lanes(std::uint64_t radix) const {
-  if (!row_per_item) return 1;
-  return radix >= 8 ? 8 : radix >= 4 ? 4 : 2;
-}
 
 StageShape stage_shape_for(unsigned native_double_width) {
   StageShape shape;

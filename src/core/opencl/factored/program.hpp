@@ -34,8 +34,6 @@ struct StageShape {
   bool split_by_team = false;
   /// The device's native double vector width (the row kernels' register budget follows it).
   unsigned native_double_width = 1;
-  /// Entries per vector: 8, 4 or 2 by the digit's radix for rows, 1 for entries.
-  std::uint64_t lanes(std::uint64_t radix) const;
 };
 StageShape stage_shape_for(unsigned native_double_width);
 

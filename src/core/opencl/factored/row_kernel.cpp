@@ -52,6 +52,9 @@ void order_rows_by_window(const FactoredStage& stage, std::uint64_t radix, ItemD
   }
 }
 
+// Entries per vector of a row of `radix` entries.
+std::uint64_t row_lanes(std::uint64_t radix) { return radix >= 8 ? 8 : radix >= 4 ? 4 : 2; }
+
 // Doubles a work-item's accumulators may hold: 24 vector registers of 32 with AVX-512, 12 of 16
 // with AVX2 (the rest hold the masses and the addresses).
 std::uint64_t accumulator_doubles(unsigned native_double_width) {
@@ -157,9 +160,11 @@ void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tu
 
 // A line of kStoreTile rows along digit `tiled` (the output's fastest), each row (or pair) into
 // private memory, then the line's entries stored side by side.
-void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, const std::vector<std::string>& rows,
+void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled,
                 std::optional<std::uint64_t> pair_tuple_stride) {
   const FactoredStage& stage = pass.stage;
+  const std::vector<std::string> rows =
+      pair_tuple_stride ? std::vector<std::string>{"_a", "_b"} : std::vector<std::string>{"_a"};
   for (const std::string& row : rows) s << "  double kept" << row << "[" << pass.radix * kStoreTile << "];\n";
   s << "  const uint tile_rows = min(" << kStoreTile << "u, " << stage.output[tiled].radix
     << "u - (uint)tile_first);\n"
@@ -241,17 +246,17 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
                 {digits.input_strides, digits.tuple_strides, digits.out_strides, digits.pair_strides,
                  digits.tile_strides},
                 {"in_index", "tuple", "out_index", "pair_first", "tile_first"});
-  const std::vector<std::string> rows = paired ? std::vector<std::string>{"_a", "_b"} : std::vector<std::string>{"_a"};
   s << "  const ulong out_index_a = out_index;\n";
   if (paired)
     s << "  const bool has_b = pair_first + 1 < " << stage.output[*paired].radix << "UL;\n"
       << "  const ulong out_index_b = out_index + " << strides[*paired] << "UL;\n";
   std::optional<std::uint64_t> pair_tuple_stride;
   if (paired) pair_tuple_stride = stage.tuple_stride[*paired];
-  RowPass pass{stage, radix, shape.lanes(radix), strides[vector_digit],
-               accumulator_doubles(shape.native_double_width) / shape.lanes(radix), "  "};
+  const std::uint64_t lanes = row_lanes(radix);
+  RowPass pass{stage, radix, lanes, strides[vector_digit], accumulator_doubles(shape.native_double_width) / lanes,
+               "  "};
   if (tiled)
-    tiled_rows(s, pass, *tiled, rows, pair_tuple_stride);
+    tiled_rows(s, pass, *tiled, pair_tuple_stride);
   else
     item_rows(s, pass, "tuple", pair_tuple_stride);
   s << "}\n\n";
