@@ -141,6 +141,52 @@ TEST(FactoredPlan, SlicesWhenTheTensorsDoNotFitAndRefusesWhatCannotFit) {
   EXPECT_NE(reason.find("budget"), std::string::npos) << reason;
 }
 
+// Traffic on 15 cells per dimension: a row of 15 values spans 16 doubles (two cache lines).
+std::string padded_traffic_yaml(unsigned horizon) { return traffic_yaml(0.5, horizon, 7.0); }
+
+TEST(FactoredPlan, StageTensorsSpanWholeCacheLinesWhereThatCostsAnEighthAtMost) {
+  std::string reason;
+  const Abstraction padded = from_yaml(padded_traffic_yaml(2));
+  const auto plan = detail::plan_factored_sweep(padded, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  ASSERT_EQ(plan->stages.size(), 3u);
+  for (std::size_t k = 0; k < plan->stages.size(); ++k) {
+    const detail::FactoredStage& stage = plan->stages[k];
+    const std::size_t digits = stage.output.size();
+    if (k + 1 == plan->stages.size()) {  // Q: never padded (its last digit is u1, 2 values)
+      EXPECT_EQ(stage.output_size, stage.output_entries);
+      continue;
+    }
+    ASSERT_EQ(stage.output.back().radix, 15u) << "stage " << k;
+    EXPECT_EQ(stage.output_stride[digits - 2], 16u) << "stage " << k;
+    EXPECT_EQ(stage.output_size, stage.output_entries / 15 * 16) << "stage " << k;
+    // The next stage reads this one's entries where this one wrote them.
+    const detail::FactoredStage& next = plan->stages[k + 1];
+    for (std::size_t j = 0; j < next.output.size(); ++j)
+      for (std::size_t i = 0; i < digits; ++i)
+        if (next.output[j].post == stage.output[i].post && next.output[j].id == stage.output[i].id)
+          EXPECT_EQ(next.input_stride[j], stage.output_stride[i]) << "stage " << k + 1 << " digit " << j;
+  }
+  // The two stage buffers' padding is in the device bytes; a budget without room for it keeps the
+  // tensors unpadded rather than slicing them.
+  const double padding_bytes =
+      2.0 * sizeof(double) * double(plan->largest_stage_tensor - plan->largest_stage_tensor / 16 * 15);
+  const auto tight = detail::plan_factored_sweep(padded, double(plan->device_bytes) - 1, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(tight) << reason;
+  EXPECT_EQ(tight->slices, 1u);
+  EXPECT_EQ(double(tight->device_bytes), double(plan->device_bytes) - padding_bytes);
+  for (const detail::FactoredStage& stage : tight->stages) EXPECT_EQ(stage.output_size, stage.output_entries);
+  // 21 cells would span 24 doubles (a seventh more): unpadded; the host's lines layout never pads.
+  const auto coarse = detail::plan_factored_sweep(from_yaml(traffic_yaml(0.4, 2)), kUnlimitedBudget, kUnlimitedBudget,
+                                                  &reason);
+  ASSERT_TRUE(coarse) << reason;
+  for (const detail::FactoredStage& stage : coarse->stages) EXPECT_EQ(stage.output_size, stage.output_entries);
+  const auto lines = detail::plan_factored_sweep(padded, kUnlimitedBudget, kUnlimitedBudget, &reason,
+                                                 detail::FactoredLayout::Lines);
+  ASSERT_TRUE(lines) << reason;
+  for (const detail::FactoredStage& stage : lines->stages) EXPECT_EQ(stage.output_size, stage.output_entries);
+}
+
 TEST(FactoredPlan, DynamicsWithoutDependenciesAreRefusedWithTheReason) {
   using namespace test_support;
   const Abstraction a = random_affine_abstraction(3, 2, 1, false, safety_spec(2));
@@ -248,22 +294,34 @@ TEST(FactoredSweep, RowsTakenWindowByWindowAreBitIdenticalToOneEntryPerWorkItem)
   EXPECT_EQ(both.rows.input_index, both.entries.input_index);
 }
 
-TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
-  const Abstraction a = from_yaml(traffic_yaml(0.4, 3));
+// A run in slices (a memory fraction that leaves room for a third of the stage tensors) gives the
+// unsliced run's inputs and values up to rounding. `padded`: the sliced plan's tensors too.
+void expect_sliced_run_equals_unsliced_run(const Abstraction& a, bool padded) {
   SynthesisReport whole_report, sliced_report;
   const Policy whole = run(a, SweepChoice::Factored, &whole_report);
   std::string reason;
   const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
   ASSERT_TRUE(plan) << reason;
-  // A memory fraction that leaves room for a third of the stage tensors forces slices.
+  const double sliced_budget = double(plan->device_bytes) * 0.6;
+  const auto sliced_plan = detail::plan_factored_sweep(a, sliced_budget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(sliced_plan) << reason;
+  const bool sliced_plan_padded = std::any_of(sliced_plan->stages.begin(), sliced_plan->stages.end(),
+                                              [](const auto& stage) { return stage.output_size > stage.output_entries; });
+  EXPECT_EQ(sliced_plan_padded, padded);
   std::vector<EngineNote> notes;
   const double global_memory = double(detail::choose_device(cpu_options().compute, notes).global_memory);
   ASSERT_GT(global_memory, 0.0);
-  const Policy sliced = run(a, SweepChoice::Factored, &sliced_report,
-                            (double(plan->device_bytes) * 0.6) / global_memory);
+  const Policy sliced = run(a, SweepChoice::Factored, &sliced_report, sliced_budget / global_memory);
   EXPECT_TRUE(has_note(sliced_report, "slices")) << "expected a sliced plan";
   EXPECT_LE(max_difference(whole.values, sliced.values), kValueTolerance);
   EXPECT_EQ(whole.input_index, sliced.input_index);
+}
+
+TEST(FactoredSweep, SlicedRunEqualsUnslicedRun) {
+  // Unpadded tensors (21 cells), and x'0's tensor padded to whole cache lines (15 cells in 16
+  // doubles; x'1's ends with a slice of x'2's cells, too few to pad).
+  expect_sliced_run_equals_unsliced_run(from_yaml(traffic_yaml(0.4, 3)), false);
+  expect_sliced_run_equals_unsliced_run(from_yaml(padded_traffic_yaml(3)), true);
 }
 
 TEST(FactoredSweep, AutoChoosesFactoredWhereItSavesWorkAndDenseOtherwise) {

@@ -3,6 +3,7 @@
 // give the bits of one entry per work-item on pocl, and the work the profile counts for them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -63,7 +64,7 @@ TEST(RowKernel, PairsTheFinestDigitThatPicksOnlyMassesAndTilesTheFastestDigit) {
   EXPECT_EQ(*tiled, x0.output.size() - 1);
   EXPECT_EQ(variable_of(x0, *tiled), 0u);
   // 21 rows of x2 in 11 pairs, 21 of x0 in 3 lines of up to 8.
-  const std::uint64_t rows = x0.output_size / x0.output[*x0.vector_digit].radix;
+  const std::uint64_t rows = x0.output_entries / x0.output[*x0.vector_digit].radix;
   EXPECT_EQ(detail::row_work_items(x0, cpu), rows / 21 * 11 / 21 * 3);
   EXPECT_EQ(detail::stage_work_items(x0, cpu), detail::row_work_items(x0, cpu));
 
@@ -81,7 +82,7 @@ TEST(RowKernel, PairsTheFinestDigitThatPicksOnlyMassesAndTilesTheFastestDigit) {
   const auto team_paired = detail::paired_digit(x0, team);
   EXPECT_TRUE(!team_paired || *team_paired > *x0.vector_digit);
   // The SIMT shape takes one entry per work-item: no rows.
-  EXPECT_EQ(detail::stage_work_items(x0, detail::stage_shape_for(1)), x0.output_size);
+  EXPECT_EQ(detail::stage_work_items(x0, detail::stage_shape_for(1)), x0.output_entries);
 }
 
 TEST(RowKernel, SmallerRegisterBudgetsTakeARowInMorePasses) {
@@ -133,13 +134,14 @@ TEST(RowKernel, StageWorkCountsEveryCellOnceWhateverTheSlicesAndPairedRowsLoadOn
 }
 
 // Policies of the factored sweep on pocl with kernels for vector width `width` (1: one entry per
-// work-item).
-Policy factored_policy(const Abstraction& a, unsigned width) {
+// work-item); `stream_bytes`: outputs above it stored past the caches (0: every aligned one).
+Policy factored_policy(const Abstraction& a, unsigned width, double stream_bytes = detail::kStreamOutputBytes) {
   SynthesisOptions options;
   options.compute.device = DeviceKind::Cpu;
   options.compute.sweep = SweepChoice::Factored;
   detail::OpenClEngineOptions engine;
   engine.factored_vector_width = width;
+  engine.factored_stream_bytes = stream_bytes;
   SynthesisReport report;
   return detail::synthesize_opencl(a, options, &report, engine);
 }
@@ -153,6 +155,32 @@ TEST(RowKernel, EveryRegisterBudgetGivesTheBitsOfOneEntryPerWorkItem) {
     const Policy entries = factored_policy(a, 1);
     for (unsigned width : {2u, 4u, 8u}) {
       const Policy rows = factored_policy(a, width);
+      EXPECT_EQ(rows.values, entries.values) << a.config.name << ", width " << width;
+      EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name << ", width " << width;
+    }
+  }
+}
+
+TEST(RowKernel, OutputsStoredPastTheCachesGiveTheSameBits) {
+  // Stage tensors padded to whole lines: traffic on 15 cells (x'1's rows of 15 values in 16
+  // doubles, x'0's lines of kept rows along x0, the last line of 7 rows ending in the padding);
+  // long rows of 101 values in 104 doubles. Streamed whatever their size (threshold 0).
+  for (const std::string& yaml : {traffic_yaml(0.5, 3, 7.0), test_support::long_rows_yaml()}) {
+    const Abstraction a = from_yaml(yaml);
+    std::string reason;
+    const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+    ASSERT_TRUE(plan) << reason;
+    detail::StageShape streamed = detail::stage_shape_for(8);
+    streamed.stream_output_bytes = 0;
+    const auto streams = [&](const detail::StageShape& shape) {
+      return std::count_if(plan->stages.begin(), plan->stages.end(),
+                           [&](const detail::FactoredStage& stage) { return detail::streams_output(stage, shape); });
+    };
+    EXPECT_EQ(streams(detail::stage_shape_for(8)), 0) << a.config.name << ": too small to stream by default";
+    EXPECT_EQ(streams(streamed), a.states.dims() - 1) << a.config.name << ": every stage tensor streams";
+    const Policy entries = factored_policy(a, 1);
+    for (unsigned width : {4u, 8u}) {
+      const Policy rows = factored_policy(a, width, 0.0);
       EXPECT_EQ(rows.values, entries.values) << a.config.name << ", width " << width;
       EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name << ", width " << width;
     }

@@ -96,11 +96,12 @@ TEST(Split, ContiguousCoveringAndProportionalToWeight) {
 // A stage whose output digits have the given radices (variables, ids 0, 1, ...).
 detail::FactoredStage stage_with(const std::vector<std::size_t>& radices, std::optional<std::size_t> vector_digit) {
   detail::FactoredStage stage;
-  stage.output_size = 1;
+  stage.output_entries = 1;
   for (std::size_t j = 0; j < radices.size(); ++j) {
     stage.output.push_back({false, j, radices[j]});
-    stage.output_size *= radices[j];
+    stage.output_entries *= radices[j];
   }
+  stage.output_size = stage.output_entries;
   stage.vector_digit = vector_digit;
   return stage;
 }

@@ -212,11 +212,12 @@ inline Abstraction random_affine_abstraction(std::uint64_t seed, std::size_t sta
   return Abstraction::from_parts(config, dynamics);
 }
 
-/// The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid: few inputs, wide windows.
-inline std::string traffic_yaml(double eta, unsigned horizon) {
-  const std::string e = std::to_string(eta);
+/// The 3-d traffic ring of config/traffic_3d.yaml on a coarser grid of [0, upper]^3: few inputs,
+/// wide windows.
+inline std::string traffic_yaml(double eta, unsigned horizon, double upper = 8) {
+  const std::string e = std::to_string(eta), u = std::to_string(upper);
   return "name: traffic_small\n"
-         "states: {lb: [0, 0, 0], ub: [8, 8, 8], eta: [" + e + ", " + e + ", " + e + "]}\n"
+         "states: {lb: [0, 0, 0], ub: [" + u + ", " + u + ", " + u + "], eta: [" + e + ", " + e + ", " + e + "]}\n"
          "inputs: {lb: [0, 0], ub: [1, 1], eta: [1, 1]}\n"
          "constants: {flow: 0.36, q: 0.5, entry1: 6.0, entry3: 8.0}\n"
          "dynamics: [\"(1 - flow)*x0 + flow*x2 + entry1*u0\", \"(1 - flow - q)*x1 + flow*x0\",\n"

@@ -104,16 +104,33 @@ std::vector<std::uint64_t> strides_of(const std::vector<TensorDigit>& layout) {
   return strides;
 }
 
+namespace {
+
+// The strides of a stage's output; `padded`: the fastest digit's values span whole cache lines
+// where that adds at most 1/kMaxLinePadding (a row of 81 values spans 88 doubles, one of 28 does
+// not span 32), so that every row, and every line of entries of the fastest digit, starts a line.
+std::vector<std::uint64_t> output_strides(const std::vector<TensorDigit>& layout, bool padded) {
+  std::vector<std::uint64_t> strides = strides_of(layout);
+  const std::uint64_t radix = layout.back().radix;
+  const std::uint64_t span = (radix + kLineDoubles - 1) / kLineDoubles * kLineDoubles;
+  if (!padded || span == radix || (span - radix) * kMaxLinePadding > radix) return strides;
+  for (std::size_t j = 0; j + 1 < layout.size(); ++j) strides[j] = strides[j] / radix * span;
+  return strides;
+}
+
+}  // namespace
+
 std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
                                         const std::vector<std::vector<std::size_t>>& reads,
                                         const std::vector<FactorVariable>& variables,
                                         const std::vector<std::size_t>& counts, const std::vector<std::size_t>& widths,
-                                        std::size_t slice_cells, FactoredLayout layout) {
+                                        std::size_t slice_cells, FactoredLayout layout, bool pad_to_lines) {
   const std::size_t dims = counts.size(), sliced = order.back();
   std::vector<std::optional<DigitId>> vectors = vector_digits(order, reads, variables, counts, slice_cells);
   if (layout == FactoredLayout::Lines) vectors.assign(order.size(), std::nullopt);
   std::vector<TensorDigit> input;
   for (std::size_t r = 0; r < dims; ++r) input.push_back({true, r, counts[r]});  // V, unsliced
+  std::vector<std::uint64_t> input_strides = strides_of(input);
   std::vector<char> used(variables.size(), 0), remaining(dims, 1);
   std::vector<FactoredStage> stages;
   for (std::size_t k = 0; k < order.size(); ++k) {
@@ -133,24 +150,26 @@ std::vector<FactoredStage> build_stages(const std::vector<std::size_t>& order,
       if (std::none_of(input.begin(), input.end(), [&](const TensorDigit& digit) { return !digit.post && digit.id == v; }))
         stage.output.push_back({false, v, variables[v].count});
     arrange_output(stage.output, k, order, vectors, variables, layout);
-    const std::vector<std::uint64_t> input_strides = strides_of(input);
     std::vector<std::uint64_t> tuple_strides(variables.size(), 0);
     std::uint64_t tuple_stride = 1;
     for (std::size_t j = reads[dim].size(); j-- > 0;) {
       tuple_strides[reads[dim][j]] = tuple_stride;
       tuple_stride *= variables[reads[dim][j]].count;
     }
-    stage.output_size = 1;
+    stage.output_stride = output_strides(stage.output, pad_to_lines && k + 1 < order.size());
+    stage.output_entries = 1;
     for (std::size_t j = 0; j < stage.output.size(); ++j) {
       const TensorDigit& digit = stage.output[j];
-      stage.output_size *= digit.radix;
+      stage.output_entries *= digit.radix;
       stage.input_stride.push_back(stride_in(input, input_strides, digit.post, digit.id));
       stage.tuple_stride.push_back(digit.post ? 0 : tuple_strides[digit.id]);
       if (vectors[k] && digit.post == vectors[k]->post && digit.id == vectors[k]->id) stage.vector_digit = j;
     }
     assert(!stage.vector_digit || (stage.input_stride[*stage.vector_digit] == 1 && stage.tuple_stride[*stage.vector_digit] == 0));
+    stage.output_size = stage.output_stride.front() * stage.output.front().radix;
     stage.contracted_stride = stride_in(input, input_strides, true, dim);
     input = stage.output;
+    input_strides = stage.output_stride;
     stages.push_back(std::move(stage));
   }
   return stages;

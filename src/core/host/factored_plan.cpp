@@ -46,6 +46,11 @@ struct OrderCost {
   double weighted = 0;
 };
 
+// Entries of the largest stage tensor W_1..W_{d-1} (all slices, unpadded); 0 with one stage.
+double stage_tensor_entries(const OrderCost& cost) {
+  return cost.sizes.size() > 1 ? *std::max_element(cost.sizes.begin(), cost.sizes.end() - 1) : 0.0;
+}
+
 // A stage whose entries cannot be computed eight at a time from contiguous values runs several
 // times slower per multiply-add (measured on pocl: ~0.9 against ~10 GMAC/s).
 constexpr double kScalarStageWeight = 8.0;
@@ -221,7 +226,7 @@ void choose_slices(const Abstraction& a, const OrderCost& cost, const std::vecto
   const double fixed_bytes = double(sizeof(double)) * (2.0 * double(a.states.size()) + double(plan.q_size)) +
                              double(a.states.size()) * (1 + sizeof(std::uint32_t)) + table_bytes;
   // Stage tensors W_1..W_{d-1} hold the sliced dimension's cells: they shrink with the slice.
-  const double largest_stage = dims > 1 ? *std::max_element(cost.sizes.begin(), cost.sizes.end() - 1) : 0.0;
+  const double largest_stage = stage_tensor_entries(cost);
   const std::size_t sliced_count = counts[plan.order.back()];
   plan.slices = 0;
   for (std::size_t slices = 1; slices <= sliced_count; ++slices) {
@@ -272,9 +277,25 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
     return refuse("its tensors need more than the budget of " + format_bytes(budget_bytes) + " (or buffers above " +
                   format_bytes(max_buffer_bytes) + ") even in slices");
   plan.slice_cells = counts[plan.order.back()] / plan.slices;
-  plan.stages = build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells, layout);
-  for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
-    plan.largest_stage_tensor = std::max(plan.largest_stage_tensor, plan.stages[k].output_size);
+  auto build = [&](bool pad_to_lines) {
+    plan.stages =
+        build_stages(plan.order, plan.reads, plan.variables, counts, widths, plan.slice_cells, layout, pad_to_lines);
+    plan.largest_stage_tensor = 0;
+    for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
+      plan.largest_stage_tensor = std::max(plan.largest_stage_tensor, plan.stages[k].output_size);
+  };
+  build(layout == FactoredLayout::Kernels);
+  // The slices were chosen for unpadded tensors: the padding of the two stage buffers must fit
+  // too, or the tensors stay unpadded.
+  const double padding_bytes =
+      2.0 * sizeof(double) * (double(plan.largest_stage_tensor) - stage_tensor_entries(best_cost) / double(plan.slices));
+  if (padding_bytes > 0) {
+    if (double(plan.device_bytes) + padding_bytes <= budget_bytes &&
+        sizeof(double) * double(plan.largest_stage_tensor) <= max_buffer_bytes)
+      plan.device_bytes += std::size_t(padding_bytes);
+    else
+      build(false);
+  }
   const FactoredStage& last = plan.stages.back();
   assert(last.output_size == plan.q_size);
   plan.q_stride.assign(plan.variables.size(), 0);

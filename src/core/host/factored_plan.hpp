@@ -48,7 +48,11 @@ struct FactoredStage {
   std::vector<std::uint64_t> input_stride;   ///< per output digit: stride in the input (0: absent)
   std::vector<std::uint64_t> tuple_stride;   ///< per output digit: stride in the mass table's tuples
   std::uint64_t contracted_stride = 0;       ///< input stride of the contracted post cell
-  std::uint64_t output_size = 0;             ///< entries of the output tensor (one slice)
+  std::vector<std::uint64_t> output_stride;  ///< per output digit: stride in the output buffer
+  std::uint64_t output_entries = 0;          ///< entries of the output tensor (one slice): the radices' product
+  /// Doubles of the output buffer (one slice): output_entries, or more where the fastest digit's
+  /// values are padded to whole cache lines (output_stride of the digit before it).
+  std::uint64_t output_size = 0;
   std::size_t width = 0;                     ///< largest number of kept cells of `dimension`
   /// Output digit whose entries are computed several at a time: input stride 1 (contiguous
   /// values), tuple stride 0 (shared masses). None: one entry per work-item.
@@ -64,7 +68,7 @@ struct FactoredPlan {
   std::size_t slices = 1;
   std::vector<std::uint64_t> q_stride;  ///< per variable: stride in Q (0: Q does not depend on it)
   std::uint64_t q_size = 0;
-  std::uint64_t largest_stage_tensor = 0;  ///< entries of the largest W_k, 0 < k < d, one slice
+  std::uint64_t largest_stage_tensor = 0;  ///< doubles of the largest W_k buffer, 0 < k < d, one slice
   double multiply_adds = 0;        ///< per time step, all slices
   double dense_multiply_adds = 0;  ///< what the dense sweep does per time step (nominal)
   std::size_t device_bytes = 0;    ///< values, Q, stage tensors and mass tables
@@ -81,7 +85,9 @@ std::size_t dense_window_width(const Abstraction& abstraction, std::size_t dim);
 double contraction_multiply_adds(const Abstraction& abstraction);
 
 /// How a plan lays out its tensors. Kernels: for the OpenCL stages, each stage's output ends with
-/// the next stage's contracted cell and vector digit (work-items read contiguous windows). Lines:
+/// the next stage's contracted cell and vector digit (work-items read contiguous windows), and
+/// the fastest digit of W_1..W_{d-1} is padded to whole cache lines where that costs at most an
+/// eighth of the tensor (rows and lines of entries then start on a line). Lines:
 /// for a host sweep that contracts one line at a time and applies every tuple of new variables to
 /// it, the output keeps the input's order, then the new variables (a line's results side by side),
 /// then the largest remaining post cell that the next stage does not contract (the next stage's

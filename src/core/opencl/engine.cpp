@@ -7,6 +7,7 @@
 
 #include "opencl/device_bandwidth.hpp"
 #include "opencl/device_peak.hpp"
+#include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/sweep.hpp"
 #include "opencl/layout.hpp"
 #include "opencl/program_cache.hpp"
@@ -115,7 +116,7 @@ Policy run_on_device(const Abstraction& a, const DeviceInfo& device, const std::
   if (!factored) return run_dense(a, device, session, options, engine_options, reporter);
   rep.transitions = "factored: per-dimension mass tables (the transitions setting applies to the dense sweep)";
   const FactoredRunContext run{&device, session.context.get(), session.queue.get(), engine_options.kernel_cache_dir,
-                               engine_options.factored_vector_width, options.profile};
+                               factored_stage_shape(device, engine_options), options.profile};
   return run_factored_sweep(a, *factored, run, reporter);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Settings of the OpenCL engines that the configuration does not expose (tests and benchmarks).
 #include <cstddef>
+#include <optional>
 #include <string>
 
 namespace amytiss::detail {
@@ -24,6 +25,9 @@ struct OpenClEngineOptions {
   /// native width. 1 takes one entry per work-item (the GPU shape) even on a SIMD device; 4 the
   /// row kernels of an AVX2 CPU on an AVX-512 one (tests).
   unsigned factored_vector_width = 0;
+  /// Factored sweep: stage outputs above this many bytes are stored past the caches where their
+  /// lines align; unset: the default of the row kernels (StageShape), 0: every aligned one (tests).
+  std::optional<double> factored_stream_bytes;
 };
 
 }  // namespace amytiss::detail

@@ -77,7 +77,7 @@ std::vector<TeamMember> set_up_members(const Abstraction& a, const FactoredPlan&
   }
   for (std::size_t i = 0; i < members.size(); ++i) {
     TeamDevice& device = team.devices()[i];
-    StageShape shape = factored_stage_shape(device.info, engine_options.factored_vector_width);
+    StageShape shape = factored_stage_shape(device.info, engine_options);
     shape.rows_in_output_order = rows_in_output_order;
     shape.split_by_team = true;
     shape.states_in_q_order = false;  // the input choice is split by states

@@ -47,8 +47,8 @@ StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t
       loads += double(rows_share_pass(union_cells, hi_a - lo_a, hi_b - lo_b) ? union_cells : apart);
     }
   }
-  // Every tuple occurs output_size / tuples times in a slice's output.
-  const double uses = double(stage.output_size) / double(tuples);
+  // Every tuple occurs output_entries / tuples times in a slice's output.
+  const double uses = double(stage.output_entries) / double(tuples);
   StageWork work;
   work.multiply_adds = uses * cells;
   work.value_loads = uses * loads;
@@ -87,8 +87,11 @@ void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTa
   check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
 }
 
-StageShape factored_stage_shape(const DeviceInfo& device, unsigned vector_width) {
-  return stage_shape_for(vector_width > 0 ? vector_width : device.native_double_width);
+StageShape factored_stage_shape(const DeviceInfo& device, const OpenClEngineOptions& options) {
+  const unsigned width = options.factored_vector_width;
+  StageShape shape = stage_shape_for(width > 0 ? width : device.native_double_width);
+  if (options.factored_stream_bytes) shape.stream_output_bytes = *options.factored_stream_bytes;
+  return shape;
 }
 
 FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan& plan, const DeviceInfo& device,

@@ -10,6 +10,7 @@
 #include "opencl/device.hpp"
 #include "host/factored_plan.hpp"
 #include "common/host_memory.hpp"
+#include "opencl/engine_options.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {
@@ -46,9 +47,9 @@ StagePlacement stage_placement(const Abstraction& abstraction, const FactoredPla
 void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
                          const StagePlacement& placement);
 
-/// The shape `device` wants, or (vector_width > 0) the shape of a device of that native double
-/// vector width (1: the SIMT shape).
-StageShape factored_stage_shape(const DeviceInfo& device, unsigned vector_width);
+/// The shape `device` wants, or (options.factored_vector_width > 0) the shape of a device of that
+/// native double vector width (1: the SIMT shape); options.factored_stream_bytes where set.
+StageShape factored_stage_shape(const DeviceInfo& device, const OpenClEngineOptions& options);
 /// A device's program of the plan (stage kernels, choose_inputs) in `shape`; a note says which.
 struct FactoredKernels {
   StageShape shape;

@@ -40,14 +40,4 @@ void window_of_tuple(std::ostringstream& s, const FactoredStage& stage, const st
     << " - kept_first" << x << ");\n";
 }
 
-std::vector<std::uint64_t> output_strides(const FactoredStage& stage) {
-  std::vector<std::uint64_t> strides(stage.output.size());
-  std::uint64_t stride = 1;
-  for (std::size_t j = stage.output.size(); j-- > 0;) {
-    strides[j] = stride;
-    stride *= stage.output[j].radix;
-  }
-  return strides;
-}
-
 }  // namespace amytiss::detail

@@ -23,7 +23,4 @@ std::string kernel_head(std::size_t k);
 void window_of_tuple(std::ostringstream& s, const FactoredStage& stage, const std::string& suffix,
                      const std::string& indent);
 
-/// Output strides of a stage's digits (row-major: the last digit fastest).
-std::vector<std::uint64_t> output_strides(const FactoredStage& stage);
-
 }  // namespace amytiss::detail

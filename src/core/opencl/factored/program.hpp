@@ -17,6 +17,11 @@ constexpr std::size_t kTensorSlack = 8;
 constexpr std::size_t kFactoredMaxLaunchItems = std::size_t(1) << 30;
 constexpr std::size_t kFactoredGroupSize = 64;
 
+/// Stage outputs above this many bytes are stored past the caches by default: larger than the
+/// last-level caches of the CPUs measured (32 MiB per core complex on the EPYCs), they are gone
+/// from the cache by the time the next stage reads them (traffic 3-d's x'0 writes 688 MB a step).
+constexpr double kStreamOutputBytes = 64.0 * 1024 * 1024;
+
 /// How a stage with a vector digit maps to work-items. SIMD devices (CPUs: native double vector
 /// width > 1) take a row of the vector digit per work-item in explicit vectors; SIMT devices
 /// (GPUs: width 1) one entry per work-item with the vector digit fastest, so that neighbouring
@@ -34,6 +39,9 @@ struct StageShape {
   bool split_by_team = false;
   /// The device's native double vector width (the row kernels' register budget follows it).
   unsigned native_double_width = 1;
+  /// Row kernels store outputs of more bytes than this past the caches where their lines align
+  /// (streams_output in opencl/factored/row_kernel.hpp); 0 streams every aligned output (tests).
+  double stream_output_bytes = kStreamOutputBytes;
 };
 StageShape stage_shape_for(unsigned native_double_width);
 

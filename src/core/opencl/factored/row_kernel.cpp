@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "host/factored_layout.hpp"
 #include "opencl/factored/kernel_text.hpp"
 
 namespace amytiss::detail {
@@ -23,6 +24,7 @@ struct ItemDigits {
 // lie a line or more apart): a line of neighbouring entries of the fastest digit, kept in private
 // memory and stored a line at a time instead of one entry per line.
 constexpr std::uint64_t kStoreTile = 8;
+static_assert(kStoreTile == kLineDoubles, "a streamed line of kept rows is one cache line");
 
 // Values the rows between two visits of the same block may read in output order for that block
 // to be still in a core's cache (the L2 of the CPUs measured: 512 KiB).
@@ -68,7 +70,35 @@ struct RowPass {
   std::string indent;
   std::string in_index = "in_index";  ///< the rows' first value in the input
   bool kept = false;                  ///< store into kept<row>[entry * kStoreTile + r], not out
+  bool stream = false;                ///< streams_output(): whole lines past the caches
 };
+
+// Stores entry `entry` .. + lanes - 1 of a row: one line past the caches where the row's entries
+// are contiguous and the output streams (lanes beyond the row, in its padding, set to 0), else
+// entry by entry.
+void store_chunk(std::ostringstream& s, const RowPass& pass, const std::string& row, const std::string& sum,
+                 std::uint64_t entry, std::uint64_t valid) {
+  const std::string& in = pass.indent;
+  const std::string target = "out + out_index" + row + " + " + std::to_string(entry * pass.lane_stride) + "UL";
+  auto lane = [&](std::uint64_t l) { return sum + ".s" + "01234567"[l]; };
+  if (pass.stream && pass.lane_stride == 1 && pass.lanes == kLineDoubles) {
+    s << in << "  {\n" << in << "    __global double* target = " << target << ";\n"
+      << in << "    if (accumulate) {\n";
+    for (std::uint64_t l = 0; l < valid; ++l) s << in << "      target[" << l << "] += " << lane(l) << ";\n";
+    std::string line = sum;
+    if (valid < pass.lanes) {
+      line = "(double8)(";
+      for (std::uint64_t l = 0; l < pass.lanes; ++l) line += (l ? ", " : "") + (l < valid ? lane(l) : "0.0");
+      line += ")";
+    }
+    s << in << "    } else {\n" << in << "      AMYTISS_STREAM_LINE(" << line << ", target);\n"
+      << in << "    }\n" << in << "  }\n";
+    return;
+  }
+  for (std::uint64_t l = 0; l < valid; ++l)
+    s << in << "  { __global double* target = out + out_index" << row << " + " << (entry + l) * pass.lane_stride
+      << "UL; *target = accumulate ? *target + " << lane(l) << " : " << lane(l) << "; }\n";
+}
 // One pass over cells [lo, hi) of the window per block of the row's chunks: per cell, the
 // block's stretch of the row (contiguous values) is loaded once, a vector per chunk, and added
 // with each named row's mass into that row's accumulators. Where the window's rows lie one after
@@ -107,15 +137,14 @@ void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std:
     for (const std::string& row : rows)
       for (std::uint64_t j = 0; j < count; ++j) {
         const std::uint64_t chunk = first + j, valid = std::min(pass.lanes, pass.radix - chunk * pass.lanes);
-        for (std::uint64_t lane = 0; lane < valid; ++lane) {
-          const std::string value = "sum" + row + std::to_string(j) + ".s" + "01234567"[lane];
-          const std::uint64_t entry = chunk * pass.lanes + lane;
-          if (pass.kept)
-            s << in << "  kept" << row << "[" << entry * kStoreTile << " + r] = " << value << ";\n";
-          else
-            s << in << "  { __global double* target = out + out_index" << row << " + " << entry * pass.lane_stride
-              << "UL; *target = accumulate ? *target + " << value << " : " << value << "; }\n";
+        const std::string sum = "sum" + row + std::to_string(j);
+        if (!pass.kept) {
+          store_chunk(s, pass, row, sum, chunk * pass.lanes, valid);
+          continue;
         }
+        for (std::uint64_t lane = 0; lane < valid; ++lane)
+          s << in << "  kept" << row << "[" << (chunk * pass.lanes + lane) * kStoreTile << " + r] = " << sum << ".s"
+            << "01234567"[lane] << ";\n";
       }
     s << in << "}\n";
   }
@@ -181,8 +210,16 @@ void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled,
     if (row == "_b") s << "  if (has_b) {\n";
     s << indent << "for (uint entry = 0; entry < " << pass.radix << "u; ++entry) {\n"
       << indent << "  __global double* line = out + out_index" << row << " + (ulong)entry * " << pass.lane_stride
-      << "UL;\n"
-      << indent << "  for (uint r = 0; r < tile_rows; ++r)\n"
+      << "UL;\n";
+    // A streamed line of kStoreTile entries starts a cache line; the last one of the digit ends in
+    // its padding, which gets zeros.
+    if (pass.stream)
+      s << indent << "  if (!accumulate) {\n"
+        << indent << "    for (uint r = tile_rows; r < " << kStoreTile << "u; ++r) kept" << row << "[entry * "
+        << kStoreTile << "u + r] = 0.0;\n"
+        << indent << "    AMYTISS_STREAM_LINE(vload8(entry, kept" << row << "), line);\n"
+        << indent << "    continue;\n" << indent << "  }\n";
+    s << indent << "  for (uint r = 0; r < tile_rows; ++r)\n"
       << indent << "    line[r] = accumulate ? line[r] + kept" << row << "[entry * " << kStoreTile << "u + r] : kept"
       << row << "[entry * " << kStoreTile << "u + r];\n"
       << indent << "}\n";
@@ -210,8 +247,14 @@ std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageSh
   return last;
 }
 
+bool streams_output(const FactoredStage& stage, const StageShape& shape) {
+  const std::size_t digits = stage.output.size();
+  const bool lines_start_lines = digits > 1 && stage.output_stride[digits - 2] % kLineDoubles == 0;
+  return lines_start_lines && double(stage.output_size) * sizeof(double) > shape.stream_output_bytes;
+}
+
 std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape) {
-  std::uint64_t items = stage.output_size / stage.output[*stage.vector_digit].radix;
+  std::uint64_t items = stage.output_entries / stage.output[*stage.vector_digit].radix;
   auto group = [&](std::optional<std::size_t> digit, std::uint64_t size) {
     if (!digit) return;
     const std::uint64_t radix = stage.output[*digit].radix;
@@ -225,7 +268,7 @@ std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape
 void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
   const std::size_t vector_digit = *stage.vector_digit;
   const std::uint64_t radix = stage.output[vector_digit].radix;
-  const std::vector<std::uint64_t> strides = output_strides(stage);
+  const std::vector<std::uint64_t>& strides = stage.output_stride;
   const std::optional<std::size_t> paired = paired_digit(stage, shape), tiled = tiled_digit(stage, shape);
   ItemDigits digits;
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
@@ -255,6 +298,7 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   const std::uint64_t lanes = row_lanes(radix);
   RowPass pass{stage, radix, lanes, strides[vector_digit], accumulator_doubles(shape.native_double_width) / lanes,
                "  "};
+  pass.stream = streams_output(stage, shape);
   if (tiled)
     tiled_rows(s, pass, *tiled, pair_tuple_stride);
   else

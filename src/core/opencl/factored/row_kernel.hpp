@@ -29,6 +29,12 @@ constexpr bool rows_share_pass(long long union_cells, long long cells_a, long lo
   return kShareUnionWeight * union_cells <= kShareCellsWeight * (cells_a + cells_b);
 }
 
+/// Whether a stage's kernel stores its output past the caches (AMYTISS_STREAM_LINE, whole lines
+/// of 8 doubles): where its output is larger than shape.stream_output_bytes (it would not stay
+/// cached until the next stage reads it, and a cached store first reads the line it writes) and
+/// every line of entries of the fastest digit starts a cache line (padded or whole lines).
+bool streams_output(const FactoredStage& stage, const StageShape& shape);
+
 /// Work-items of a stage with a vector digit on a SIMD device: its rows, or its pairs of rows.
 std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape);
 

@@ -27,7 +27,7 @@ class FactoredStep : public BellmanStep {
     for (std::size_t k = 0; k < plan.stages.size(); ++k) {
       const StageWork work = stage_work(a, plan, k, tables[plan.stages[k].dimension], kernels.shape);
       multiply_adds_[k] = work.multiply_adds;
-      bytes_[k] = 8.0 * (work.value_loads + double(plan.stages[k].output_size) * double(plan.slices));
+      bytes_[k] = 8.0 * (work.value_loads + double(plan.stages[k].output_entries) * double(plan.slices));
       memory_bytes_[k] = work.memory_bytes;
     }
     bytes_.back() = memory_bytes_.back() = 8.0 * double(plan.q_size) + 12.0 * double(a.states.size());
@@ -113,7 +113,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   SynthesisReport& report = reporter.report();
   auto phase_start = SteadyClock::now();
   FactoredKernels kernels = build_factored_kernels(a, plan, *run.device, run.context, run.kernel_cache_dir,
-                                                   factored_stage_shape(*run.device, run.vector_width), report.notes);
+                                                   run.shape, report.notes);
   reporter.phase(PhaseKind::KernelBuild, "kernel build", seconds_since(phase_start));
   reporter.reached(Phase::Setup);
 

@@ -8,6 +8,7 @@
 #include "host/backward_driver.hpp"
 #include "opencl/device.hpp"
 #include "host/factored_plan.hpp"
+#include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {
 
@@ -17,7 +18,7 @@ struct FactoredRunContext {
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   std::string kernel_cache_dir;  ///< see build_program
-  unsigned vector_width = 0;     ///< of the kernels; 0: the device's (OpenClEngineOptions)
+  StageShape shape;              ///< of the kernels (factored_stage_shape)
   bool profile = false;          ///< finish every kernel before its clock stops
 };
 
