@@ -1,6 +1,7 @@
-// The factored sweep's row kernels for SIMD devices (src/core/opencl/factored/row_kernel.*): which
-// digits a work-item takes two or a line at a time, that the kernels of every register budget
-// give the bits of one entry per work-item on pocl, and the work the profile counts for them.
+// The factored sweep's row kernels for SIMD devices (src/core/opencl/factored/row_kernel.*,
+// fused_stage.*): which digits a work-item takes two or a line at a time, which stages fuse, that
+// the kernels of every register budget, streamed or fused, give the bits of one entry per
+// work-item on pocl, and the work the profile counts for them.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include "host/factored_plan.hpp"
 #include "opencl/engine_options.hpp"
 #include "opencl/factored/device_parts.hpp"
+#include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/program.hpp"
 #include "opencl/factored/row_kernel.hpp"
 #include "opencl/factored/tables.hpp"
@@ -135,15 +137,16 @@ TEST(RowKernel, StageWorkCountsEveryCellOnceWhateverTheSlicesAndPairedRowsLoadOn
 
 // Policies of the factored sweep on pocl with kernels for vector width `width` (1: one entry per
 // work-item); `stream_bytes`: outputs above it stored past the caches (0: every aligned one).
-Policy factored_policy(const Abstraction& a, unsigned width, double stream_bytes = detail::kStreamOutputBytes) {
+Policy factored_policy(const Abstraction& a, unsigned width, double stream_bytes = detail::kStreamOutputBytes,
+                       SynthesisReport* report = nullptr) {
   SynthesisOptions options;
   options.compute.device = DeviceKind::Cpu;
   options.compute.sweep = SweepChoice::Factored;
   detail::OpenClEngineOptions engine;
   engine.factored_vector_width = width;
   engine.factored_stream_bytes = stream_bytes;
-  SynthesisReport report;
-  return detail::synthesize_opencl(a, options, &report, engine);
+  SynthesisReport own_report;
+  return detail::synthesize_opencl(a, options, report ? report : &own_report, engine);
 }
 
 TEST(RowKernel, EveryRegisterBudgetGivesTheBitsOfOneEntryPerWorkItem) {
@@ -185,6 +188,39 @@ TEST(RowKernel, OutputsStoredPastTheCachesGiveTheSameBits) {
       EXPECT_EQ(rows.input_index, entries.input_index) << a.config.name << ", width " << width;
     }
   }
+}
+
+TEST(RowKernel, TheLastStageFusesWithTheStageWhoseLinesOfRowsItContracts) {
+  // Traffic: x'2 (the last stage) contracts x'0's vector digit (x'2's post cell) and computes
+  // along x0, the digit along which x'0 keeps lines of rows: x'0's work-items contract their
+  // lines into Q, and x'0's tensor is never written.
+  const Abstraction a = from_yaml(traffic_yaml(0.4, 3));
+  std::string reason;
+  const auto plan = detail::plan_factored_sweep(a, kUnlimitedBudget, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(plan) << reason;
+  ASSERT_EQ(plan->stages.size(), 3u);
+  ASSERT_EQ(plan->stages[1].dimension, 0u);
+  const detail::StageShape cpu = detail::stage_shape_for(8);
+  EXPECT_FALSE(detail::fuses_next(*plan, 0, cpu)) << "x'0 does not contract x'1's lines";
+  EXPECT_TRUE(detail::fuses_next(*plan, 1, cpu));
+  EXPECT_FALSE(detail::fuses_next(*plan, 2, cpu)) << "the last stage has no next";
+  EXPECT_FALSE(detail::fuses_next(*plan, 1, detail::stage_shape_for(1))) << "one entry per work-item keeps no lines";
+  detail::StageShape team = cpu;
+  team.split_by_team = true;
+  EXPECT_FALSE(detail::fuses_next(*plan, 1, team)) << "a team splits and exchanges every stage";
+  const auto sliced = detail::plan_factored_sweep(a, double(plan->device_bytes) * 0.6, kUnlimitedBudget, &reason);
+  ASSERT_TRUE(sliced) << reason;
+  ASSERT_GT(sliced->slices, 1u);
+  EXPECT_FALSE(detail::fuses_next(*sliced, 1, cpu)) << "slices accumulate into Q stage by stage";
+  // The same bits as the stages apart (one entry per work-item), in less device memory.
+  SynthesisReport fused_report, apart_report;
+  const Policy fused = factored_policy(a, 8, detail::kStreamOutputBytes, &fused_report);
+  const Policy apart = factored_policy(a, 1, detail::kStreamOutputBytes, &apart_report);
+  EXPECT_TRUE(test_support::has_note(fused_report, "stages 1 and 2 fused"));
+  EXPECT_FALSE(test_support::has_note(apart_report, "fused"));
+  EXPECT_EQ(fused.values, apart.values);
+  EXPECT_EQ(fused.input_index, apart.input_index);
+  EXPECT_EQ(apart_report.device_bytes - fused_report.device_bytes, 8 * plan->stages[1].output_size);
 }
 
 }  // namespace

@@ -28,6 +28,7 @@ const std::vector<std::string> kParts = {"cpu:0/1"};
 const std::vector<std::string> kUnequal = {"cpu:0", "cpu:0/1"};
 
 using test_support::from_yaml;
+using test_support::has_note;
 
 // Traffic-like 3-d chain (each coordinate reads two states and at most one input): factored.
 std::string chain_yaml() {
@@ -67,11 +68,6 @@ Policy run(const Abstraction& a, SweepChoice sweep, const std::vector<std::strin
 void expect_identical(const Policy& one, const Policy& many) {
   EXPECT_EQ(one.values, many.values);  // bit-identical, not within a tolerance
   EXPECT_EQ(one.input_index, many.input_index);
-}
-
-bool has_note(const SynthesisReport& report, const std::string& fragment) {
-  return std::any_of(report.notes.begin(), report.notes.end(),
-                     [&](const EngineNote& note) { return note.text.find(fragment) != std::string::npos; });
 }
 
 std::size_t cpu_compute_units() {

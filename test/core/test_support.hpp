@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/model.hpp"
+#include "amytiss/synthesis_types.hpp"
 
 namespace amytiss {
 namespace test_support {
@@ -274,6 +276,12 @@ std::string refusal(Action action) {
   }
   ADD_FAILURE() << "no PolicyFileError was thrown";
   return "";
+}
+
+/// Whether one of the report's notes contains `fragment`.
+inline bool has_note(const SynthesisReport& report, const std::string& fragment) {
+  return std::any_of(report.notes.begin(), report.notes.end(),
+                     [&](const EngineNote& note) { return note.text.find(fragment) != std::string::npos; });
 }
 
 }  // namespace test_support

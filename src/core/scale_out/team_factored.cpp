@@ -90,7 +90,7 @@ std::vector<TeamMember> set_up_members(const Abstraction& a, const FactoredPlan&
   tables = factored_mass_tables(a, plan);
   for (std::size_t i = 0; i < members.size(); ++i) {
     members[i].buffers = allocate_factored_buffers(a, plan, tables, team.devices()[i].session.context.get(),
-                                                   team.devices()[i].info.is_cpu());
+                                                   team.devices()[i].info.is_cpu(), members[i].kernels.shape);
     rep.device_bytes = std::max(rep.device_bytes, members[i].buffers.device_bytes);
   }
   reporter.phase(PhaseKind::Construction, "construction", seconds_since(phase_start));

@@ -5,6 +5,8 @@
 #include <optional>
 #include <utility>
 
+#include "amytiss/format.hpp"
+#include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/row_kernel.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/program_cache.hpp"
@@ -87,6 +89,12 @@ void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTa
   check(clSetKernelArg(kernel, 8, sizeof(cl_uint), &placement.accumulate), "clSetKernelArg");
 }
 
+void set_fused_arguments(cl_kernel kernel, const DeviceTable& next_table) {
+  check(clSetKernelArg(kernel, 9, sizeof(cl_mem), &next_table.first.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 10, sizeof(cl_mem), &next_table.count.handle), "clSetKernelArg");
+  check(clSetKernelArg(kernel, 11, sizeof(cl_mem), &next_table.masses.handle), "clSetKernelArg");
+}
+
 StageShape factored_stage_shape(const DeviceInfo& device, const OpenClEngineOptions& options) {
   const unsigned width = options.factored_vector_width;
   StageShape shape = stage_shape_for(width > 0 ? width : device.native_double_width);
@@ -103,6 +111,13 @@ FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan&
                    std::string("factored stages: ") +
                        (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
                                                    : "one entry per work-item, neighbours contiguous (SIMT device)")});
+  for (std::size_t k = 0; k < plan.stages.size(); ++k)
+    if (fuses_next(plan, k, shape))
+      notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                       "factored stages " + std::to_string(k) + " and " + std::to_string(k + 1) + " fused: x'" +
+                           std::to_string(plan.stages[k].dimension) + "'s lines of rows contracted over x'" +
+                           std::to_string(plan.stages[k + 1].dimension) + " into Q by the same work-item (" +
+                           format_bytes(8.0 * double(plan.stages[k].output_size)) + " a step neither written nor read)"});
   kernels.program = build_program(context, device, factored_program_source(a, plan, kernels.shape), cache_dir, notes);
   for (std::size_t k = 0; k < plan.stages.size(); ++k)
     kernels.stages.push_back(create_kernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str()));
@@ -117,7 +132,8 @@ std::vector<double> factored_terminal_values(const Abstraction& a) {
 }
 
 FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPlan& plan,
-                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device) {
+                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device,
+                                          const StageShape& shape) {
   const std::size_t n_states = a.states.size();
   FactoredBuffers buffers;
   cl_int error = CL_SUCCESS;
@@ -148,9 +164,12 @@ FactoredBuffers allocate_factored_buffers(const Abstraction& a, const FactoredPl
   };
   buffers.host_blocks.reserve(3);
   buffers.q = make_large(plan.q_size * sizeof(double));
+  // Stage k writes stage tensor k % 2, except the last (Q) and a stage fused with it.
+  std::uint64_t written[2] = {0, 0};
+  for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k)
+    if (!fuses_next(plan, k, shape)) written[k % 2] = std::max(written[k % 2], plan.stages[k].output_size);
   if (plan.stages.size() > 1)
-    for (Buffer& tensor : buffers.stage_tensors)
-      tensor = make_large((plan.largest_stage_tensor + kTensorSlack) * sizeof(double));
+    for (int t = 0; t < 2; ++t) buffers.stage_tensors[t] = make_large((written[t] + kTensorSlack) * sizeof(double));
   return buffers;
 }
 

@@ -46,6 +46,8 @@ StagePlacement stage_placement(const Abstraction& abstraction, const FactoredPla
 /// placement.
 void set_stage_arguments(cl_kernel kernel, cl_mem in, cl_mem out, const DeviceTable& table,
                          const StagePlacement& placement);
+/// The further arguments of a stage kernel fused with the next stage: that stage's table.
+void set_fused_arguments(cl_kernel kernel, const DeviceTable& next_table);
 
 /// The shape `device` wants, or (options.factored_vector_width > 0) the shape of a device of that
 /// native double vector width (1: the SIMT shape); options.factored_stream_bytes where set.
@@ -69,9 +71,11 @@ struct FactoredBuffers {
   Buffer roles, values[2], best_input, q, stage_tensors[2];
   std::size_t device_bytes = 0;
 };
-/// `cpu_device`: Q and the stage tensors live in HostBlocks (common/host_memory.hpp).
+/// `cpu_device`: Q and the stage tensors live in HostBlocks (common/host_memory.hpp). The two
+/// stage tensors hold what the kernels of `shape` write (not the tensor of a fused stage).
 FactoredBuffers allocate_factored_buffers(const Abstraction& abstraction, const FactoredPlan& plan,
-                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device);
+                                          const std::vector<MassTable>& tables, cl_context context, bool cpu_device,
+                                          const StageShape& shape);
 /// V_{T_d} per state, then kTensorSlack zero cells.
 std::vector<double> factored_terminal_values(const Abstraction& abstraction);
 

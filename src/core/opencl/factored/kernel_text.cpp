@@ -21,11 +21,15 @@ void decode_digits(std::ostringstream& s, const std::string& index, const std::v
   }
 }
 
-std::string kernel_head(std::size_t k) {
+std::string kernel_head(std::size_t k, bool fused) {
   return "__kernel void stage" + std::to_string(k) +
          "(__global const double* in, __global double* out, __global const uint* first,\n"
          "    __global const uint* count, __global const double* masses, ulong in_offset, uint block_first,\n"
-         "    uint block_end, uint accumulate) {\n";
+         "    uint block_end, uint accumulate" +
+         (fused ? ",\n    __global const uint* next_first, __global const uint* next_count,\n"
+                  "    __global const double* next_masses"
+                : "") +
+         ") {\n";
 }
 
 void window_of_tuple(std::ostringstream& s, const FactoredStage& stage, const std::string& suffix,

@@ -14,8 +14,9 @@ namespace amytiss::detail {
 void decode_digits(std::ostringstream& s, const std::string& index, const std::vector<std::uint64_t>& radices,
                    const std::vector<std::vector<std::uint64_t>>& strides, const std::vector<std::string>& targets);
 
-/// The signature of stage kernel `k` (its arguments: device_parts.cpp sets them).
-std::string kernel_head(std::size_t k);
+/// The signature of stage kernel `k` (its arguments: device_parts.cpp sets them); `fused`: also
+/// the next stage's mass table (next_first, next_count, next_masses).
+std::string kernel_head(std::size_t k, bool fused = false);
 
 /// The kept cells of the window of tuple `tuple<suffix>` that lie in the block of the contracted
 /// dimension held by the input ([block_first, block_end): all of it, except in the last stage of

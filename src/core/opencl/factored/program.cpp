@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "amytiss/abstraction.hpp"
+#include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/kernel_text.hpp"
 #include "opencl/factored/row_kernel.hpp"
 
@@ -46,9 +47,10 @@ void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::
   s << "  out[out_index] = accumulate ? out[out_index] + sum : sum;\n}\n\n";
 }
 
-void stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
+void stage_kernel(std::ostringstream& s, const FactoredPlan& plan, std::size_t k, const StageShape& shape) {
+  const FactoredStage& stage = plan.stages[k];
   if (stage.vector_digit && shape.row_per_item)
-    row_stage_kernel(s, stage, k, shape);
+    row_stage_kernel(s, stage, k, shape, fuses_next(plan, k, shape) ? &plan.stages[k + 1] : nullptr);
   else
     entry_stage_kernel(s, stage, k);
 }
@@ -171,7 +173,7 @@ std::string factored_program_source(const Abstraction& abstraction, const Factor
     << "#define AMYTISS_STREAM_LINE(line, target) __builtin_nontemporal_store(line, (__global double8*)(target))\n"
     << "#endif\n#endif\n#ifndef AMYTISS_STREAM_LINE\n"
     << "#define AMYTISS_STREAM_LINE(line, target) vstore8(line, 0, target)\n#endif\n\n";
-  for (std::size_t k = 0; k < plan.stages.size(); ++k) stage_kernel(s, plan.stages[k], k, shape);
+  for (std::size_t k = 0; k < plan.stages.size(); ++k) stage_kernel(s, plan, k, shape);
   choose_inputs_kernel(s, abstraction, plan, shape);
   return s.str();
 }

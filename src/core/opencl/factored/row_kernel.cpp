@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "host/factored_layout.hpp"
+#include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/kernel_text.hpp"
 
 namespace amytiss::detail {
@@ -18,6 +19,7 @@ namespace {
 // The work-item digits of a row kernel: every output digit but the vector digit.
 struct ItemDigits {
   std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides, pair_strides, tile_strides;
+  std::vector<std::uint64_t> next_tuple_strides, next_out_strides;  ///< a fused next stage's
 };
 
 // Rows per work-item where the vector digit is not the output's fastest digit (a row's entries
@@ -47,7 +49,7 @@ void order_rows_by_window(const FactoredStage& stage, std::uint64_t radix, ItemD
     std::stable_partition(order.begin() + 1, order.end(), [&](std::size_t j) { return digits.input_strides[j] != 0; });
   for (auto* values :
        {&digits.radices, &digits.input_strides, &digits.tuple_strides, &digits.out_strides, &digits.pair_strides,
-        &digits.tile_strides}) {
+        &digits.tile_strides, &digits.next_tuple_strides, &digits.next_out_strides}) {
     std::vector<std::uint64_t> permuted;
     for (std::size_t j : order) permuted.push_back((*values)[j]);
     *values = permuted;
@@ -71,6 +73,7 @@ struct RowPass {
   std::string in_index = "in_index";  ///< the rows' first value in the input
   bool kept = false;                  ///< store into kept<row>[entry * kStoreTile + r], not out
   bool stream = false;                ///< streams_output(): whole lines past the caches
+  const FactoredStage* next = nullptr;  ///< the last stage, fused: lines of kept rows go into Q
 };
 
 // Stores entry `entry` .. + lanes - 1 of a row: one line past the caches where the row's entries
@@ -189,8 +192,8 @@ void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tu
 
 // A line of kStoreTile rows along digit `tiled` (the output's fastest), each row (or pair) into
 // private memory, then the line's entries stored side by side.
-void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled,
-                std::optional<std::uint64_t> pair_tuple_stride) {
+void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, std::optional<std::uint64_t> pair_tuple_stride,
+                const StageShape& shape) {
   const FactoredStage& stage = pass.stage;
   const std::vector<std::string> rows =
       pair_tuple_stride ? std::vector<std::string>{"_a", "_b"} : std::vector<std::string>{"_a"};
@@ -205,6 +208,10 @@ void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled,
   pass.kept = true;
   item_rows(s, pass, "tuple_r", pair_tuple_stride);
   s << "  }\n";
+  if (pass.next) {
+    contract_kept_lines(s, stage, *pass.next, paired_digit(stage, shape), rows);
+    return;
+  }
   for (const std::string& row : rows) {
     const std::string indent = row == "_b" ? "    " : "  ";
     if (row == "_b") s << "  if (has_b) {\n";
@@ -265,15 +272,19 @@ std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape
   return items;
 }
 
-void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
+void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape,
+                      const FactoredStage* fused_next) {
   const std::size_t vector_digit = *stage.vector_digit;
   const std::uint64_t radix = stage.output[vector_digit].radix;
   const std::vector<std::uint64_t>& strides = stage.output_stride;
   const std::optional<std::size_t> paired = paired_digit(stage, shape), tiled = tiled_digit(stage, shape);
   ItemDigits digits;
+  const NextStrides next = fused_next ? next_strides(stage, *fused_next) : NextStrides{};
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
     if (j == vector_digit) continue;
     const std::uint64_t scale = paired == j ? 2 : tiled == j ? kStoreTile : 1;
+    digits.next_tuple_strides.push_back(fused_next ? next.tuple[j] * scale : 0);
+    digits.next_out_strides.push_back(fused_next ? next.out[j] * scale : 0);
     digits.radices.push_back((stage.output[j].radix + scale - 1) / scale);
     digits.input_strides.push_back(stage.input_stride[j] * scale);
     digits.tuple_strides.push_back(stage.tuple_stride[j] * scale);
@@ -282,13 +293,14 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
     digits.tile_strides.push_back(tiled == j ? kStoreTile : 0);
   }
   if (!shape.rows_in_output_order) order_rows_by_window(stage, radix, digits);
-  s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
+  s << kernel_head(k, fused_next) << "  const ulong item = get_global_id(0);\n"
     << "  if (item >= " << row_work_items(stage, shape) << "UL) return;\n"
-    << "  ulong in_index = in_offset, tuple = 0, out_index = 0, pair_first = 0, tile_first = 0;\n";
+    << "  ulong in_index = in_offset, tuple = 0, out_index = 0, pair_first = 0, tile_first = 0, next_tuple = 0, "
+       "next_out = 0;\n";
   decode_digits(s, "item", digits.radices,
                 {digits.input_strides, digits.tuple_strides, digits.out_strides, digits.pair_strides,
-                 digits.tile_strides},
-                {"in_index", "tuple", "out_index", "pair_first", "tile_first"});
+                 digits.tile_strides, digits.next_tuple_strides, digits.next_out_strides},
+                {"in_index", "tuple", "out_index", "pair_first", "tile_first", "next_tuple", "next_out"});
   s << "  const ulong out_index_a = out_index;\n";
   if (paired)
     s << "  const bool has_b = pair_first + 1 < " << stage.output[*paired].radix << "UL;\n"
@@ -299,8 +311,9 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   RowPass pass{stage, radix, lanes, strides[vector_digit], accumulator_doubles(shape.native_double_width) / lanes,
                "  "};
   pass.stream = streams_output(stage, shape);
+  pass.next = fused_next;
   if (tiled)
-    tiled_rows(s, pass, *tiled, pair_tuple_stride);
+    tiled_rows(s, pass, *tiled, pair_tuple_stride, shape);
   else
     item_rows(s, pass, "tuple", pair_tuple_stride);
   s << "}\n\n";

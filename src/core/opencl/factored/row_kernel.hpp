@@ -38,7 +38,9 @@ bool streams_output(const FactoredStage& stage, const StageShape& shape);
 /// Work-items of a stage with a vector digit on a SIMD device: its rows, or its pairs of rows.
 std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape);
 
-/// Stage kernel `k` (a stage with a vector digit) for a SIMD device.
-void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape);
+/// Stage kernel `k` (a stage with a vector digit) for a SIMD device; `fused_next`: the last
+/// stage, computed from this one's lines of kept rows (fuses_next in fused_stage.hpp).
+void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape,
+                      const FactoredStage* fused_next = nullptr);
 
 }  // namespace amytiss::detail

@@ -7,6 +7,7 @@
 
 #include "amytiss/format.hpp"
 #include "opencl/factored/device_parts.hpp"
+#include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/tables.hpp"
 
 namespace amytiss::detail {
@@ -29,6 +30,16 @@ class FactoredStep : public BellmanStep {
       multiply_adds_[k] = work.multiply_adds;
       bytes_[k] = 8.0 * (work.value_loads + double(plan.stages[k].output_entries) * double(plan.slices));
       memory_bytes_[k] = work.memory_bytes;
+      fused_.push_back(fuses_next(plan, k, kernels.shape));
+    }
+    // A fused pair is one launch (one slice): the work of both, the loads of both (the second's
+    // from the first's lines of rows), the second's stores; in memory the first's input and Q.
+    for (std::size_t k = 0; k + 1 < plan.stages.size(); ++k) {
+      if (!fused_[k]) continue;
+      multiply_adds_[k] += multiply_adds_[k + 1];
+      bytes_[k] += bytes_[k + 1] - 8.0 * double(plan.stages[k].output_entries);
+      memory_bytes_[k] += 8.0 * (double(plan.stages[k + 1].output_size) - double(plan.stages[k].output_size));
+      multiply_adds_[k + 1] = bytes_[k + 1] = memory_bytes_[k + 1] = 0;
     }
     bytes_.back() = memory_bytes_.back() = 8.0 * double(plan.q_size) + 12.0 * double(a.states.size());
   }
@@ -47,9 +58,14 @@ class FactoredStep : public BellmanStep {
   // The profile's breakdown: every stage's and the input choice's time over `steps` steps.
   void report_breakdown(StepReporter& reporter, unsigned steps) const {
     for (std::size_t k = 0; k <= plan_.stages.size(); ++k) {
-      const std::string name = k < plan_.stages.size() ? "stage " + std::to_string(k) + " (x'" +
-                                                             std::to_string(plan_.stages[k].dimension) + ", all steps)"
-                                                       : "input choice (all steps)";
+      if (k > 0 && k < plan_.stages.size() && fused_[k - 1]) continue;  // in the line of stage k - 1
+      std::string name = "input choice (all steps)";
+      if (k < plan_.stages.size() && fused_[k])
+        name = "stages " + std::to_string(k) + "+" + std::to_string(k + 1) + " (x'" +
+               std::to_string(plan_.stages[k].dimension) + " + x'" + std::to_string(plan_.stages[k + 1].dimension) +
+               " fused, all steps)";
+      else if (k < plan_.stages.size())
+        name = "stage " + std::to_string(k) + " (x'" + std::to_string(plan_.stages[k].dimension) + ", all steps)";
       reporter.phase(PhaseKind::Breakdown, name, seconds_[k], 0, multiply_adds_[k] * steps, bytes_[k] * steps,
                      memory_bytes_[k] * steps);
     }
@@ -77,6 +93,7 @@ class FactoredStep : public BellmanStep {
   FactoredBuffers& buffers_;
   std::size_t group_;
   std::vector<double> seconds_, multiply_adds_, bytes_, memory_bytes_;
+  std::vector<bool> fused_;  ///< per stage: its kernel also computes the next (fused_stage.hpp)
   int current_ = 0;
 };
 
@@ -84,13 +101,15 @@ void FactoredStep::apply_resident(const double*, double* out, std::uint32_t* cho
   const std::size_t n_states = a_.states.size(), last_stage = plan_.stages.size() - 1;
   for (std::size_t slice = 0; slice < plan_.slices; ++slice) {
     for (std::size_t k = 0; k < plan_.stages.size(); ++k) {
+      if (k > 0 && fused_[k - 1]) continue;  // computed by stage k - 1's kernel
       const FactoredStage& stage = plan_.stages[k];
       cl_mem in = k == 0 ? buffers_.values[current_].get() : buffers_.stage_tensors[(k - 1) % 2].get();
-      cl_mem stage_out = k == last_stage ? buffers_.q.get() : buffers_.stage_tensors[k % 2].get();
+      cl_mem stage_out = k == last_stage || fused_[k] ? buffers_.q.get() : buffers_.stage_tensors[k % 2].get();
       // The first stage reads the slice out of V; the last contracts the slice's cells only.
       cl_kernel kernel = kernels_.stages[k].get();
       set_stage_arguments(kernel, in, stage_out, buffers_.tables[stage.dimension],
                           stage_placement(a_, plan_, k, slice));
+      if (fused_[k]) set_fused_arguments(kernel, buffers_.tables[plan_.stages[k + 1].dimension]);
       launch(kernel, stage_work_items(stage, kernels_.shape), k);
     }
   }
@@ -120,7 +139,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   // Construction: the kept masses of every dimension, once.
   phase_start = SteadyClock::now();
   const std::vector<MassTable> tables = factored_mass_tables(a, plan);
-  FactoredBuffers buffers = allocate_factored_buffers(a, plan, tables, run.context, run.device->is_cpu());
+  FactoredBuffers buffers = allocate_factored_buffers(a, plan, tables, run.context, run.device->is_cpu(), kernels.shape);
   report.device_bytes = buffers.device_bytes;
   report.notes.push_back(
       {NoteSeverity::Info, NoteKind::DeviceMemory, "device memory: " + format_bytes(double(buffers.device_bytes))});
