@@ -148,7 +148,7 @@ std::string FactoredPlan::describe() const {
   for (std::size_t dim : order) text += " x'" + std::to_string(dim);
   char numbers[200];
   std::snprintf(numbers, sizeof numbers,
-                "; %.3g multiply-adds per step against %.3g for the dense sweep (%.1fx fewer); %zu slice%s; ",
+                "; %.3g multiply-adds per step against %.3g for the dense sweep (%.1fx fewer); %zu slice%s; at most ",
                 multiply_adds, dense_multiply_adds, dense_multiply_adds / std::max(multiply_adds, 1.0), slices,
                 slices == 1 ? "" : "s");
   text += numbers + format_bytes(double(device_bytes));

@@ -71,7 +71,7 @@ struct FactoredPlan {
   std::uint64_t largest_stage_tensor = 0;  ///< doubles of the largest W_k buffer, 0 < k < d, one slice
   double multiply_adds = 0;        ///< per time step, all slices
   double dense_multiply_adds = 0;  ///< what the dense sweep does per time step (nominal)
-  std::size_t device_bytes = 0;    ///< values, Q, stage tensors and mass tables
+  std::size_t device_bytes = 0;    ///< values, Q, both stage tensors and mass tables (fused stages need less)
 
   /// One line for the engine notes: order, slices, multiply-adds against the dense sweep.
   std::string describe() const;
