@@ -59,8 +59,10 @@ struct Problem {
 const Problem kProblems[] = {
     // The 3-d traffic ring on a coarser grid: few inputs, wide windows.
     {"traffic", test_support::traffic_yaml(0.4, 4)},
+    // 15 cells a dimension: the factored stage tensors' rows padded to 16 doubles.
+    {"traffic_padded", test_support::traffic_yaml(0.5, 3, 7.0)},
     {"robot_disturbance", test_support::robot_disturbance_yaml()},
-    // Rows of 101 entries along the first stage's vector digit.
+    // Rows of 101 entries along the first stage's vector digit (104 doubles in the stage tensor).
     {"long_rows", test_support::long_rows_yaml()},
     {"multiplicative",
      "name: multiplicative_small\n"

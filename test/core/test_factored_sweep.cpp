@@ -301,8 +301,8 @@ void expect_sliced_run_equals_unsliced_run(const Abstraction& a, bool padded) {
   const double sliced_budget = double(plan->device_bytes) * 0.6;
   const auto sliced_plan = detail::plan_factored_sweep(a, sliced_budget, kUnlimitedBudget, &reason);
   ASSERT_TRUE(sliced_plan) << reason;
-  const bool sliced_plan_padded = std::any_of(sliced_plan->stages.begin(), sliced_plan->stages.end(),
-                                              [](const auto& stage) { return stage.output_size > stage.output_entries; });
+  const auto stage_padded = [](const detail::FactoredStage& stage) { return stage.output_size > stage.output_entries; };
+  const bool sliced_plan_padded = std::any_of(sliced_plan->stages.begin(), sliced_plan->stages.end(), stage_padded);
   EXPECT_EQ(sliced_plan_padded, padded);
   std::vector<EngineNote> notes;
   const double global_memory = double(detail::choose_device(cpu_options().compute, notes).global_memory);

@@ -287,8 +287,8 @@ std::optional<FactoredPlan> plan_factored_sweep(const Abstraction& a, double bud
   build(layout == FactoredLayout::Kernels);
   // The slices were chosen for unpadded tensors: the padding of the two stage buffers must fit
   // too, or the tensors stay unpadded.
-  const double padding_bytes =
-      2.0 * sizeof(double) * (double(plan.largest_stage_tensor) - stage_tensor_entries(best_cost) / double(plan.slices));
+  const double unpadded_entries = stage_tensor_entries(best_cost) / double(plan.slices);
+  const double padding_bytes = 2.0 * sizeof(double) * (double(plan.largest_stage_tensor) - unpadded_entries);
   if (padding_bytes > 0) {
     if (double(plan.device_bytes) + padding_bytes <= budget_bytes &&
         sizeof(double) * double(plan.largest_stage_tensor) <= max_buffer_bytes)

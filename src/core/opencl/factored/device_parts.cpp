@@ -111,13 +111,15 @@ FactoredKernels build_factored_kernels(const Abstraction& a, const FactoredPlan&
                    std::string("factored stages: ") +
                        (kernels.shape.row_per_item ? "a row of entries per work-item in double vectors (SIMD device)"
                                                    : "one entry per work-item, neighbours contiguous (SIMT device)")});
-  for (std::size_t k = 0; k < plan.stages.size(); ++k)
-    if (fuses_next(plan, k, shape))
-      notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
-                       "factored stages " + std::to_string(k) + " and " + std::to_string(k + 1) + " fused: x'" +
-                           std::to_string(plan.stages[k].dimension) + "'s lines of rows contracted over x'" +
-                           std::to_string(plan.stages[k + 1].dimension) + " into Q by the same work-item (" +
-                           format_bytes(8.0 * double(plan.stages[k].output_size)) + " a step neither written nor read)"});
+  for (std::size_t k = 0; k < plan.stages.size(); ++k) {
+    if (!fuses_next(plan, k, shape)) continue;
+    const std::string between = format_bytes(8.0 * double(plan.stages[k].output_size));
+    notes.push_back({NoteSeverity::Info, NoteKind::Sweep,
+                     "factored stages " + std::to_string(k) + " and " + std::to_string(k + 1) + " fused: x'" +
+                         std::to_string(plan.stages[k].dimension) + "'s lines of rows contracted over x'" +
+                         std::to_string(plan.stages[k + 1].dimension) + " into Q by the same work-item (" + between +
+                         " a step neither written nor read)"});
+  }
   kernels.program = build_program(context, device, factored_program_source(a, plan, kernels.shape), cache_dir, notes);
   for (std::size_t k = 0; k < plan.stages.size(); ++k)
     kernels.stages.push_back(create_kernel(kernels.program.get(), ("stage" + std::to_string(k)).c_str()));

@@ -139,7 +139,8 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   // Construction: the kept masses of every dimension, once.
   phase_start = SteadyClock::now();
   const std::vector<MassTable> tables = factored_mass_tables(a, plan);
-  FactoredBuffers buffers = allocate_factored_buffers(a, plan, tables, run.context, run.device->is_cpu(), kernels.shape);
+  FactoredBuffers buffers =
+      allocate_factored_buffers(a, plan, tables, run.context, run.device->is_cpu(), kernels.shape);
   report.device_bytes = buffers.device_bytes;
   report.notes.push_back(
       {NoteSeverity::Info, NoteKind::DeviceMemory, "device memory: " + format_bytes(double(buffers.device_bytes))});
