@@ -83,8 +83,10 @@ TEST(RowKernel, PairsTheFinestDigitThatPicksOnlyMassesAndTilesTheFastestDigit) {
   team.split_by_team = true;
   const auto team_paired = detail::paired_digit(x0, team);
   EXPECT_TRUE(!team_paired || *team_paired > *x0.vector_digit);
-  // The SIMT shape takes one entry per work-item: no rows.
-  EXPECT_EQ(detail::stage_work_items(x0, detail::stage_shape_for(1)), x0.output_entries);
+  // The SIMT shape takes one entry per work-item, or two along the same paired digit: no rows.
+  const detail::StageShape simt = detail::stage_shape_for(1);
+  EXPECT_EQ(detail::paired_digit(x0, simt), paired);
+  EXPECT_EQ(detail::stage_work_items(x0, simt), x0.output_entries / 21 * 11);
 }
 
 TEST(RowKernel, SmallerRegisterBudgetsTakeARowInMorePasses) {
@@ -126,13 +128,17 @@ TEST(RowKernel, StageWorkCountsEveryCellOnceWhateverTheSlicesAndPairedRowsLoadOn
   const detail::StageShape entries = detail::stage_shape_for(1), rows = detail::stage_shape_for(8);
   const detail::StageWork once = total_work(a, *whole, entries), in_slices = total_work(a, *sliced, entries);
   EXPECT_NEAR(in_slices.multiply_adds, once.multiply_adds, kCountTolerance * once.multiply_adds);
-  // One entry per work-item loads a value per multiply-add; pairs of rows that share a pass load
-  // each value once for both (x'0's x2 and x'1's x1 neighbours: windows a fraction of a cell apart).
-  EXPECT_NEAR(once.value_loads, once.multiply_adds, kCountTolerance * once.multiply_adds);
+  // Pairs of rows, or of entries, that share a pass load each value once for both (x'0's x2 and
+  // x'1's x1 neighbours: windows a fraction of a cell apart); a team pairs no digit before the
+  // vector digit, so that x'0's x2 neighbours load their values once each.
   const detail::StageWork paired = total_work(a, *whole, rows);
   EXPECT_NEAR(paired.multiply_adds, once.multiply_adds, kCountTolerance * once.multiply_adds);
   EXPECT_LT(paired.value_loads, 0.7 * paired.multiply_adds);
   EXPECT_GT(paired.value_loads, 0.5 * paired.multiply_adds);
+  EXPECT_NEAR(once.value_loads, paired.value_loads, kCountTolerance * once.value_loads);
+  detail::StageShape team = entries;
+  team.split_by_team = true;
+  EXPECT_GT(total_work(a, *whole, team).value_loads, paired.value_loads);
 }
 
 // Policies of the factored sweep on pocl with kernels for vector width `width` (1: one entry per

@@ -16,8 +16,7 @@ namespace amytiss::detail {
 StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t k, const MassTable& table,
                      const StageShape& shape) {
   const FactoredStage& stage = plan.stages[k];
-  std::optional<std::size_t> paired;
-  if (stage.vector_digit && shape.row_per_item) paired = paired_digit(stage, shape);
+  const std::optional<std::size_t> paired = paired_digit(stage, shape);
   const std::size_t tuples = table.count.size();
   // Per slice, every tuple's window clipped to the block the input holds, as the kernels clip it.
   auto window = [&](std::size_t tuple, const StagePlacement& placement) {

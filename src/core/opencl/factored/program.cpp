@@ -14,37 +14,69 @@
 namespace amytiss::detail {
 namespace {
 
-// `sum`: one entry's FMA chain over its window's cells in order.
-void entry_sum(std::ostringstream& s, const FactoredStage& stage) {
-  s << "  const ulong tuple_a = tuple;\n";
-  window_of_tuple(s, stage, "_a", "  ");
-  s << "  __global const double* v = in + in_index + (ulong)(lo_a - block_first) * " << stage.contracted_stride
-    << "UL;\n  double sum = 0.0;\n"
-    << "  for (int c = 0; c < cells_a; ++c) sum = fma(m_a[c], v[(ulong)c * " << stage.contracted_stride
-    << "UL], sum);\n";
+// One entry's FMA chain over cells [lo, hi) of the window into sum<row>; `masked`: of a pass over
+// both rows' windows, a cell outside the row's own window adding fma(0, v, s) == s exactly.
+void entry_chain(std::ostringstream& s, const FactoredStage& stage, const std::vector<std::string>& rows,
+                 const std::string& lo, const std::string& hi, const std::string& indent) {
+  s << indent << "for (uint c = " << lo << "; c < " << hi << "; ++c) {\n"
+    << indent << "  const double value = in[in_index + (ulong)(c - block_first) * " << stage.contracted_stride
+    << "UL];\n";
+  for (const std::string& row : rows)
+    s << indent << "  sum" << row << " = fma("
+      << (rows.size() == 1 ? "m" + row + "[c - lo" + row + "]"
+                           : "c >= lo" + row + " && c < hi" + row + " ? m" + row + "[c - lo" + row + "] : 0.0")
+      << ", value, sum" << row << ");\n";
+  s << indent << "}\n";
 }
 
-// One output entry per work-item; the vector digit (if any) fastest, so that neighbouring
-// work-items read neighbouring values (SIMT devices, and stages without a vector digit).
-void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k) {
+// One entry per work-item, or two along the paired digit (neighbouring states whose windows
+// nearly coincide: one pass over their union loads each value once for both, where
+// rows_share_pass); the vector digit (if any) fastest, so that neighbouring work-items read
+// neighbouring values (SIMT devices, and stages without a vector digit).
+void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::size_t k, const StageShape& shape) {
   const std::vector<std::uint64_t>& strides = stage.output_stride;
+  const std::optional<std::size_t> paired = paired_digit(stage, shape);
   std::vector<std::size_t> order;
   for (std::size_t j = 0; j < stage.output.size(); ++j)
     if (stage.vector_digit != j) order.push_back(j);
   if (stage.vector_digit) order.push_back(*stage.vector_digit);
-  std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides;
+  std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides, pair_strides;
   for (std::size_t j : order) {
-    radices.push_back(stage.output[j].radix);
-    input_strides.push_back(stage.input_stride[j]);
-    tuple_strides.push_back(stage.tuple_stride[j]);
-    out_strides.push_back(strides[j]);
+    const std::uint64_t scale = paired == j ? 2 : 1;
+    radices.push_back((stage.output[j].radix + scale - 1) / scale);
+    input_strides.push_back(stage.input_stride[j] * scale);
+    tuple_strides.push_back(stage.tuple_stride[j] * scale);
+    out_strides.push_back(strides[j] * scale);
+    pair_strides.push_back(paired == j ? 2 : 0);
   }
   s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
-    << "  if (item >= " << stage.output_entries << "UL) return;\n"
-    << "  ulong in_index = in_offset, tuple = 0, out_index = 0;\n";
-  decode_digits(s, "item", radices, {input_strides, tuple_strides, out_strides}, {"in_index", "tuple", "out_index"});
-  entry_sum(s, stage);
-  s << "  out[out_index] = accumulate ? out[out_index] + sum : sum;\n}\n\n";
+    << "  if (item >= " << stage_work_items(stage, shape) << "UL) return;\n"
+    << "  ulong in_index = in_offset, tuple = 0, out_index = 0, pair_first = 0;\n";
+  decode_digits(s, "item", radices, {input_strides, tuple_strides, out_strides, pair_strides},
+                {"in_index", "tuple", "out_index", "pair_first"});
+  s << "  const ulong tuple_a = tuple;\n  double sum_a = 0.0;\n";
+  window_of_tuple(s, stage, "_a", "  ");
+  if (!paired) {
+    entry_chain(s, stage, {"_a"}, "lo_a", "hi_a", "  ");
+    s << "  out[out_index] = accumulate ? out[out_index] + sum_a : sum_a;\n}\n\n";
+    return;
+  }
+  s << "  const bool has_b = pair_first + 1 < " << stage.output[*paired].radix << "UL;\n"
+    << "  const ulong tuple_b = tuple + (has_b ? " << stage.tuple_stride[*paired] << "UL : 0UL);\n"
+    << "  double sum_b = 0.0;\n";
+  window_of_tuple(s, stage, "_b", "  ");
+  s << "  const uint lo_ab = min(lo_a, lo_b), hi_ab = max(hi_a, hi_b);\n"
+    << "  if (has_b && " << kShareUnionWeight << " * (int)(hi_ab - lo_ab) <= " << kShareCellsWeight
+    << " * (cells_a + cells_b)) {\n";
+  entry_chain(s, stage, {"_a", "_b"}, "lo_ab", "hi_ab", "    ");
+  s << "  } else {\n";
+  entry_chain(s, stage, {"_a"}, "lo_a", "hi_a", "    ");
+  s << "    if (has_b) {\n";
+  entry_chain(s, stage, {"_b"}, "lo_b", "hi_b", "      ");
+  s << "    }\n  }\n"
+    << "  out[out_index] = accumulate ? out[out_index] + sum_a : sum_a;\n"
+    << "  if (has_b) {\n    const ulong out_b = out_index + " << strides[*paired] << "UL;\n"
+    << "    out[out_b] = accumulate ? out[out_b] + sum_b : sum_b;\n  }\n}\n\n";
 }
 
 void stage_kernel(std::ostringstream& s, const FactoredPlan& plan, std::size_t k, const StageShape& shape) {
@@ -52,7 +84,7 @@ void stage_kernel(std::ostringstream& s, const FactoredPlan& plan, std::size_t k
   if (stage.vector_digit && shape.row_per_item)
     row_stage_kernel(s, stage, k, shape, fuses_next(plan, k, shape) ? &plan.stages[k + 1] : nullptr);
   else
-    entry_stage_kernel(s, stage, k);
+    entry_stage_kernel(s, stage, k, shape);
 }
 
 // Q's radices and strides of the variables of one space, in the variables' order.
@@ -154,8 +186,11 @@ StageShape stage_shape_for(unsigned native_double_width) {
 }
 
 std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& shape) {
-  if (!stage.vector_digit || !shape.row_per_item) return stage.output_entries;
-  return row_work_items(stage, shape);
+  if (stage.vector_digit && shape.row_per_item) return row_work_items(stage, shape);
+  const std::optional<std::size_t> paired = paired_digit(stage, shape);
+  if (!paired) return stage.output_entries;
+  const std::uint64_t radix = stage.output[*paired].radix;
+  return stage.output_entries / radix * ((radix + 1) / 2);
 }
 
 std::uint64_t choose_work_items(const Abstraction& abstraction, const StageShape& shape) {

@@ -238,6 +238,7 @@ void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, std::opt
 
 std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageShape& shape) {
   std::optional<std::size_t> best;
+  if (shape.split_by_team && !stage.vector_digit) return best;  // a team splits it by entries
   const std::size_t first = shape.split_by_team ? *stage.vector_digit + 1 : 0;
   for (std::size_t j = first; j < stage.output.size(); ++j) {
     if (stage.vector_digit == j || stage.input_stride[j] != 0 || stage.tuple_stride[j] == 0) continue;

@@ -11,10 +11,11 @@
 
 namespace amytiss::detail {
 
-/// The output digit whose neighbouring values a row work-item takes two at a time: the digit that
-/// picks only masses (input stride 0) with the most values (the finest grid: the two windows are
-/// shifted least), ties to the faster digit; none when no such digit has two values or more.
-/// A team's shape (split_by_team) takes it after the vector digit only.
+/// The output digit whose neighbouring values a work-item takes two at a time (a row kernel's
+/// rows, or one entry per work-item's entries): the digit that picks only masses (input stride 0)
+/// with the most values (the finest grid: the two windows are shifted least), ties to the faster
+/// digit; none when no such digit has two values or more. A team's shape (split_by_team) takes it
+/// after the vector digit only, and none in a stage without one (the team splits it by entries).
 std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageShape& shape);
 
 /// The output's fastest digit where it is not the vector digit (nor the paired digit) and has
