@@ -102,6 +102,7 @@ void store_chunk(std::ostringstream& s, const RowPass& pass, const std::string& 
     s << in << "  { __global double* target = out + out_index" << row << " + " << (entry + l) * pass.lane_stride
       << "UL; *target = accumulate ? *target + " << lane(l) << " : " << lane(l) << "; }\n";
 }
+
 // One pass over cells [lo, hi) of the window per block of the row's chunks: per cell, the
 // block's stretch of the row (contiguous values) is loaded once, a vector per chunk, and added
 // with each named row's mass into that row's accumulators. Where the window's rows lie one after
