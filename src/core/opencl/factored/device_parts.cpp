@@ -17,6 +17,7 @@ StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t
                      const StageShape& shape) {
   const FactoredStage& stage = plan.stages[k];
   const std::optional<std::size_t> paired = paired_digit(stage, shape);
+  const std::uint64_t group = rows_per_item(stage, shape);
   const std::size_t tuples = table.count.size();
   // Per slice, every tuple's window clipped to the block the input holds, as the kernels clip it.
   auto window = [&](std::size_t tuple, const StagePlacement& placement) {
@@ -37,15 +38,16 @@ StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t
       }
       const std::uint64_t stride = stage.tuple_stride[*paired], radix = stage.output[*paired].radix;
       const std::uint64_t value = tuple / stride % radix;
-      if (value % 2 == 1) continue;  // counted with its pair's first row
-      if (value + 1 == radix) {
-        loads += double(hi_a - lo_a);
-        continue;
+      if (value % group != 0) continue;  // counted with its group's first row
+      long long lo = lo_a, hi = hi_a, apart = hi_a - lo_a;
+      for (std::uint64_t i = 1; i < std::min(group, radix - value); ++i) {
+        const auto [lo_i, hi_i] = window(tuple + i * stride, placement);
+        lo = std::min(lo, lo_i);
+        hi = std::max(hi, hi_i);
+        apart += hi_i - lo_i;
       }
-      const auto [lo_b, hi_b] = window(tuple + stride, placement);
-      const long long union_cells = std::max(hi_a, hi_b) - std::min(lo_a, lo_b);
-      const long long apart = (hi_a - lo_a) + (hi_b - lo_b);
-      loads += double(rows_share_pass(union_cells, hi_a - lo_a, hi_b - lo_b) ? union_cells : apart);
+      const bool alone = value + 1 == radix;
+      loads += double(!alone && rows_share_pass(hi - lo, apart) ? hi - lo : apart);
     }
   }
   // Every tuple occurs output_entries / tuples times in a slice's output.

@@ -54,11 +54,12 @@ void contract_kept_lines(std::ostringstream& s, const FactoredStage& stage, cons
     << "    ulong next_tuple_f = next_tuple, next_out_f = next_out;\n    {\n";
   decode_digits(s, "fresh", fresh_radices, {fresh_tuple, fresh_out}, {"next_tuple_f", "next_out_f"});
   s << "    }\n";
-  for (const std::string& row : rows) {
-    const bool b = row == "_b";
-    const std::string tuple_shift = b ? " + " + std::to_string(strides.tuple[*paired]) + "UL" : "";
-    const std::string out_shift = b ? " + " + std::to_string(strides.out[*paired]) + "UL" : "";
-    s << (b ? "    if (has_b) {\n" : "    {\n") << "      const ulong tuple_n = next_tuple_f" << tuple_shift << ";\n"
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::string& row = rows[i];
+    const std::string tuple_shift = i ? " + " + std::to_string(i * strides.tuple[*paired]) + "UL" : "";
+    const std::string out_shift = i ? " + " + std::to_string(i * strides.out[*paired]) + "UL" : "";
+    s << (i ? "    if (has" + row + ") {\n" : "    {\n") << "      const ulong tuple_n = next_tuple_f" << tuple_shift
+      << ";\n"
       << "      const uint lo_n = next_first[tuple_n];\n"
       << "      const int cells_n = (int)next_count[tuple_n];\n"
       << "      __global const double* m_n = next_masses + tuple_n * " << next.width << "UL;\n"

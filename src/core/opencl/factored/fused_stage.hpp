@@ -28,7 +28,7 @@ struct NextStrides {
 NextStrides next_strides(const FactoredStage& stage, const FactoredStage& next);
 
 /// What replaces the stores of a fused kernel's lines of kept rows: for every tuple of the
-/// variables new to `next` and every row (`rows`: _a, and _b where has_b), the line's kept
+/// variables new to `next` and every row (`rows`: _a, then _b, ... where has_<row>), the line's kept
 /// entries contracted over `next`'s window of the tuple into Q, the same FMA chain per entry as
 /// `next`'s own kernel. Reads next_tuple, next_out (the work-item's first line in `next`'s
 /// tuples and output), tile_rows and kept<row>.

@@ -1,8 +1,8 @@
-// Why two rows per work-item: on a CPU a row's contraction loads a vector of values per FMA, and
-// the loads, not the FMAs, bound it (the stage's values come from L2, a cache line or two per
-// vector). Two rows whose windows cover nearly the same cells of the same values (neighbouring
+// Why two (or four) rows per work-item: on a CPU a row's contraction loads a vector of values per
+// FMA, and the loads, not the FMAs, bound it (the stage's values come from L2, a cache line or two
+// per vector). Rows whose windows cover nearly the same cells of the same values (neighbouring
 // values of a digit that picks only masses: neighbouring states whose post coordinates lie a
-// fraction of a cell apart) load each vector once for two FMAs.
+// fraction of a cell apart) load each vector once for two (four) FMAs.
 #include "opencl/factored/row_kernel.hpp"
 
 #include <algorithm>
@@ -74,6 +74,7 @@ struct RowPass {
   bool kept = false;                  ///< store into kept<row>[entry * kStoreTile + r], not out
   bool stream = false;                ///< streams_output(): whole lines past the caches
   const FactoredStage* next = nullptr;  ///< the last stage, fused: lines of kept rows go into Q
+  std::uint64_t group = 1;              ///< rows along the paired digit (rows_per_item)
 };
 
 // Stores entry `entry` .. + lanes - 1 of a row: one line past the caches where the row's entries
@@ -138,12 +139,17 @@ void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std:
       s << in << "    }\n";
     }
     s << in << "  }\n";
+    // A group's pass computes every row; a row the paired digit lacks (past its last value) is
+    // not stored: its entries would land on another row's.
     for (const std::string& row : rows)
       for (std::uint64_t j = 0; j < count; ++j) {
         const std::uint64_t chunk = first + j, valid = std::min(pass.lanes, pass.radix - chunk * pass.lanes);
         const std::string sum = "sum" + row + std::to_string(j);
         if (!pass.kept) {
+          const bool guarded = row != "_a";
+          if (guarded) s << in << "  if (has" << row << ") {\n";
           store_chunk(s, pass, row, sum, chunk * pass.lanes, valid);
+          if (guarded) s << in << "  }\n";
           continue;
         }
         for (std::uint64_t lane = 0; lane < valid; ++lane)
@@ -154,35 +160,48 @@ void row_pass(std::ostringstream& s, const RowPass& pass, const std::vector<std:
   }
 }
 
-// The kernel's body after the digit decoding, with a paired digit: rows _a and (where the digit
-// has a second value) _b; one pass for both where rows_share_pass (nearly the same cells), else a
-// pass each.
-void paired_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple,
-                 std::uint64_t pair_tuple_stride) {
+// The kernel's body after the digit decoding, with a paired digit: rows _a, _b, ... (row_name),
+// those past _a where the digit has their values (has_<row>); one pass for all where
+// rows_share_pass over the union of their windows, else a pass each.
+void grouped_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple, std::uint64_t pair_tuple_stride,
+                  std::uint64_t group) {
   const std::string& in = pass.indent;
-  s << in << "const ulong tuple_a = " << tuple << ", tuple_b = " << tuple << " + (has_b ? " << pair_tuple_stride
-    << "UL : 0UL);\n";
-  window_of_tuple(s, pass.stage, "_a", in);
-  window_of_tuple(s, pass.stage, "_b", in);
-  s << in << "const uint lo_ab = min(lo_a, lo_b), hi_ab = max(hi_a, hi_b);\n"
-    << in << "if (has_b && " << kShareUnionWeight << " * (int)(hi_ab - lo_ab) <= " << kShareCellsWeight
-    << " * (cells_a + cells_b)) {\n";
+  std::vector<std::string> rows;
+  for (std::uint64_t i = 0; i < group; ++i) rows.push_back(row_name(i));
+  s << in << "const ulong tuple_a = " << tuple << ";\n";
+  for (std::uint64_t i = 1; i < group; ++i)
+    s << in << "const ulong tuple" << rows[i] << " = " << tuple << " + (has" << rows[i] << " ? "
+      << i * pair_tuple_stride << "UL : 0UL);\n";
+  for (const std::string& row : rows) window_of_tuple(s, pass.stage, row, in);
+  // A row the digit lacks repeats row _a's window: the union is that of the rows present.
+  std::string lo = "lo_a", hi = "hi_a", cells = "cells_a";
+  for (std::uint64_t i = 1; i < group; ++i) {
+    lo = "min(" + lo + ", lo" + rows[i] + ")";
+    hi = "max(" + hi + ", hi" + rows[i] + ")";
+    cells += " + (has" + rows[i] + " ? cells" + rows[i] + " : 0)";
+  }
+  s << in << "const uint lo_all = " << lo << ", hi_all = " << hi << ";\n"
+    << in << "if (has_b && " << kShareUnionWeight << " * (int)(hi_all - lo_all) <= " << kShareCellsWeight << " * ("
+    << cells << ")) {\n";
   RowPass inner = pass;
   inner.indent = in + "  ";
-  row_pass(s, inner, {"_a", "_b"}, "lo_ab", "hi_ab");
+  row_pass(s, inner, rows, "lo_all", "hi_all");
   s << in << "} else {\n";
   row_pass(s, inner, {"_a"}, "lo_a", "hi_a");
-  s << in << "  if (has_b) {\n";
   inner.indent = in + "    ";
-  row_pass(s, inner, {"_b"}, "lo_b", "hi_b");
-  s << in << "  }\n" << in << "}\n";
+  for (std::uint64_t i = 1; i < group; ++i) {
+    s << in << "  if (has" << rows[i] << ") {\n";
+    row_pass(s, inner, {rows[i]}, "lo" + rows[i], "hi" + rows[i]);
+    s << in << "  }\n";
+  }
+  s << in << "}\n";
 }
 
-// The rows of a work-item (one, or a pair) from tuple `tuple` and input index `pass.in_index`.
+// The rows of a work-item (one, or a group) from tuple `tuple` and input index `pass.in_index`.
 void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tuple,
                std::optional<std::uint64_t> pair_tuple_stride) {
   if (pair_tuple_stride) {
-    paired_rows(s, pass, tuple, *pair_tuple_stride);
+    grouped_rows(s, pass, tuple, *pair_tuple_stride, pass.group);
     return;
   }
   s << pass.indent << "const ulong tuple_a = " << tuple << ";\n";
@@ -196,8 +215,8 @@ void item_rows(std::ostringstream& s, const RowPass& pass, const std::string& tu
 void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, std::optional<std::uint64_t> pair_tuple_stride,
                 const StageShape& shape) {
   const FactoredStage& stage = pass.stage;
-  const std::vector<std::string> rows =
-      pair_tuple_stride ? std::vector<std::string>{"_a", "_b"} : std::vector<std::string>{"_a"};
+  std::vector<std::string> rows;
+  for (std::uint64_t i = 0; i < pass.group; ++i) rows.push_back(row_name(i));
   for (const std::string& row : rows) s << "  double kept" << row << "[" << pass.radix * kStoreTile << "];\n";
   s << "  const uint tile_rows = min(" << kStoreTile << "u, " << stage.output[tiled].radix
     << "u - (uint)tile_first);\n"
@@ -214,8 +233,9 @@ void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, std::opt
     return;
   }
   for (const std::string& row : rows) {
-    const std::string indent = row == "_b" ? "    " : "  ";
-    if (row == "_b") s << "  if (has_b) {\n";
+    const bool guarded = row != "_a";
+    const std::string indent = guarded ? "    " : "  ";
+    if (guarded) s << "  if (has" << row << ") {\n";
     s << indent << "for (uint entry = 0; entry < " << pass.radix << "u; ++entry) {\n"
       << indent << "  __global double* line = out + out_index" << row << " + (ulong)entry * " << pass.lane_stride
       << "UL;\n";
@@ -231,7 +251,7 @@ void tiled_rows(std::ostringstream& s, RowPass pass, std::size_t tiled, std::opt
       << indent << "    line[r] = accumulate ? line[r] + kept" << row << "[entry * " << kStoreTile << "u + r] : kept"
       << row << "[entry * " << kStoreTile << "u + r];\n"
       << indent << "}\n";
-    if (row == "_b") s << "  }\n";
+    if (guarded) s << "  }\n";
   }
 }
 
@@ -256,6 +276,19 @@ std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageSh
   return last;
 }
 
+std::string row_name(std::uint64_t i) { return std::string("_") + char('a' + i); }
+
+std::uint64_t rows_per_item(const FactoredStage& stage, const StageShape& shape) {
+  const std::optional<std::size_t> paired = paired_digit(stage, shape);
+  if (!paired) return 1;
+  if (!stage.vector_digit || !shape.row_per_item) return 2;
+  const std::uint64_t radix = stage.output[*stage.vector_digit].radix, lanes = row_lanes(radix);
+  const std::uint64_t chunks = (radix + lanes - 1) / lanes;
+  const std::uint64_t accumulators = accumulator_doubles(shape.native_double_width) / lanes;
+  return kMaxRowsPerItem * chunks <= accumulators && stage.output[*paired].radix >= kMaxRowsPerItem ? kMaxRowsPerItem
+                                                                                                    : 2;
+}
+
 bool streams_output(const FactoredStage& stage, const StageShape& shape) {
   const std::size_t digits = stage.output.size();
   const bool lines_start_lines = digits > 1 && stage.output_stride[digits - 2] % kLineDoubles == 0;
@@ -269,7 +302,7 @@ std::uint64_t row_work_items(const FactoredStage& stage, const StageShape& shape
     const std::uint64_t radix = stage.output[*digit].radix;
     items = items / radix * ((radix + size - 1) / size);
   };
-  group(paired_digit(stage, shape), 2);
+  group(paired_digit(stage, shape), rows_per_item(stage, shape));
   group(tiled_digit(stage, shape), kStoreTile);
   return items;
 }
@@ -280,18 +313,19 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
   const std::uint64_t radix = stage.output[vector_digit].radix;
   const std::vector<std::uint64_t>& strides = stage.output_stride;
   const std::optional<std::size_t> paired = paired_digit(stage, shape), tiled = tiled_digit(stage, shape);
+  const std::uint64_t group = rows_per_item(stage, shape);
   ItemDigits digits;
   const NextStrides next = fused_next ? next_strides(stage, *fused_next) : NextStrides{};
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
     if (j == vector_digit) continue;
-    const std::uint64_t scale = paired == j ? 2 : tiled == j ? kStoreTile : 1;
+    const std::uint64_t scale = paired == j ? group : tiled == j ? kStoreTile : 1;
     digits.next_tuple_strides.push_back(fused_next ? next.tuple[j] * scale : 0);
     digits.next_out_strides.push_back(fused_next ? next.out[j] * scale : 0);
     digits.radices.push_back((stage.output[j].radix + scale - 1) / scale);
     digits.input_strides.push_back(stage.input_stride[j] * scale);
     digits.tuple_strides.push_back(stage.tuple_stride[j] * scale);
     digits.out_strides.push_back(strides[j] * scale);
-    digits.pair_strides.push_back(paired == j ? 2 : 0);
+    digits.pair_strides.push_back(paired == j ? group : 0);
     digits.tile_strides.push_back(tiled == j ? kStoreTile : 0);
   }
   if (!shape.rows_in_output_order) order_rows_by_window(stage, radix, digits);
@@ -304,9 +338,9 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
                  digits.tile_strides, digits.next_tuple_strides, digits.next_out_strides},
                 {"in_index", "tuple", "out_index", "pair_first", "tile_first", "next_tuple", "next_out"});
   s << "  const ulong out_index_a = out_index;\n";
-  if (paired)
-    s << "  const bool has_b = pair_first + 1 < " << stage.output[*paired].radix << "UL;\n"
-      << "  const ulong out_index_b = out_index + " << strides[*paired] << "UL;\n";
+  for (std::uint64_t i = 1; i < group; ++i)
+    s << "  const bool has" << row_name(i) << " = pair_first + " << i << " < " << stage.output[*paired].radix << "UL;\n"
+      << "  const ulong out_index" << row_name(i) << " = out_index + " << i * strides[*paired] << "UL;\n";
   std::optional<std::uint64_t> pair_tuple_stride;
   if (paired) pair_tuple_stride = stage.tuple_stride[*paired];
   const std::uint64_t lanes = row_lanes(radix);
@@ -314,6 +348,7 @@ void row_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::si
                "  "};
   pass.stream = streams_output(stage, shape);
   pass.next = fused_next;
+  pass.group = group;
   if (tiled)
     tiled_rows(s, pass, *tiled, pair_tuple_stride, shape);
   else

@@ -1,10 +1,11 @@
 #pragma once
 // The factored sweep's stage kernels for SIMD devices (internal): a row of the vector digit per
-// work-item in explicit double vectors, two rows where their windows share most cells,
+// work-item in explicit double vectors, two or four rows where their windows share most cells,
 // a line of rows where a row's entries lie a line or more apart.
 #include <cstdint>
 #include <optional>
 #include <sstream>
+#include <string>
 
 #include "host/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
@@ -22,12 +23,19 @@ std::optional<std::size_t> paired_digit(const FactoredStage& stage, const StageS
 /// more than two values: a row work-item takes a line of its neighbouring values.
 std::optional<std::size_t> tiled_digit(const FactoredStage& stage, const StageShape& shape);
 
-/// Whether a pair of rows takes one pass over the union of its windows (cells [lo, hi) each,
-/// clipped to the block): where the union is at most 3/4 of their cells together
-/// (kShareUnionWeight x union <= kShareCellsWeight x cells; the kernels test the same).
+/// Rows (or entries) a work-item takes along the paired digit: 1 without one; in a row kernel
+/// kMaxRowsPerItem where their accumulators fit the register budget in one block (short rows:
+/// each vector loaded once for that many FMAs), else 2. Row names: row_name(0) = "_a", ...
+constexpr std::uint64_t kMaxRowsPerItem = 4;
+std::uint64_t rows_per_item(const FactoredStage& stage, const StageShape& shape);
+std::string row_name(std::uint64_t i);
+
+/// Whether a group of rows (a pair, or rows_per_item) takes one pass over the union of its
+/// windows (cells [lo, hi) each, clipped to the block): where the union is at most 3/4 of their
+/// cells together (kShareUnionWeight x union <= kShareCellsWeight x cells; the kernels test the same).
 constexpr long long kShareUnionWeight = 4, kShareCellsWeight = 3;
-constexpr bool rows_share_pass(long long union_cells, long long cells_a, long long cells_b) {
-  return kShareUnionWeight * union_cells <= kShareCellsWeight * (cells_a + cells_b);
+constexpr bool rows_share_pass(long long union_cells, long long cells) {
+  return kShareUnionWeight * union_cells <= kShareCellsWeight * cells;
 }
 
 /// Whether a stage's kernel stores its output past the caches (AMYTISS_STREAM_LINE, whole lines
