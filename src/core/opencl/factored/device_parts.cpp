@@ -46,8 +46,8 @@ StageWork stage_work(const Abstraction& a, const FactoredPlan& plan, std::size_t
         hi = std::max(hi, hi_i);
         apart += hi_i - lo_i;
       }
-      const bool alone = value + 1 == radix;
-      loads += double(!alone && rows_share_pass(hi - lo, apart) ? hi - lo : apart);
+      // One row alone never shares: 4 x cells > 3 x cells (or both are 0).
+      loads += double(rows_share_pass(hi - lo, apart) ? hi - lo : apart);
     }
   }
   // Every tuple occurs output_entries / tuples times in a slice's output.

@@ -14,8 +14,8 @@
 namespace amytiss::detail {
 namespace {
 
-// One entry's FMA chain over cells [lo, hi) of the window into sum<row>; `masked`: of a pass over
-// both rows' windows, a cell outside the row's own window adding fma(0, v, s) == s exactly.
+// Each row's FMA chain over cells [lo, hi) of the window into sum<row>; with two rows (a pass over
+// both windows) a cell outside a row's own window adds fma(0, v, s) == s exactly.
 void entry_chain(std::ostringstream& s, const FactoredStage& stage, const std::vector<std::string>& rows,
                  const std::string& lo, const std::string& hi, const std::string& indent) {
   s << indent << "for (uint c = " << lo << "; c < " << hi << "; ++c) {\n"
@@ -42,12 +42,12 @@ void entry_stage_kernel(std::ostringstream& s, const FactoredStage& stage, std::
   if (stage.vector_digit) order.push_back(*stage.vector_digit);
   std::vector<std::uint64_t> radices, input_strides, tuple_strides, out_strides, pair_strides;
   for (std::size_t j : order) {
-    const std::uint64_t scale = paired == j ? 2 : 1;
+    const std::uint64_t scale = paired == j ? rows_per_item(stage, shape) : 1;
     radices.push_back((stage.output[j].radix + scale - 1) / scale);
     input_strides.push_back(stage.input_stride[j] * scale);
     tuple_strides.push_back(stage.tuple_stride[j] * scale);
     out_strides.push_back(strides[j] * scale);
-    pair_strides.push_back(paired == j ? 2 : 0);
+    pair_strides.push_back(paired == j ? scale : 0);
   }
   s << kernel_head(k) << "  const ulong item = get_global_id(0);\n"
     << "  if (item >= " << stage_work_items(stage, shape) << "UL) return;\n"
@@ -189,8 +189,8 @@ std::uint64_t stage_work_items(const FactoredStage& stage, const StageShape& sha
   if (stage.vector_digit && shape.row_per_item) return row_work_items(stage, shape);
   const std::optional<std::size_t> paired = paired_digit(stage, shape);
   if (!paired) return stage.output_entries;
-  const std::uint64_t radix = stage.output[*paired].radix;
-  return stage.output_entries / radix * ((radix + 1) / 2);
+  const std::uint64_t radix = stage.output[*paired].radix, group = rows_per_item(stage, shape);
+  return stage.output_entries / radix * ((radix + group - 1) / group);
 }
 
 std::uint64_t choose_work_items(const Abstraction& abstraction, const StageShape& shape) {
