@@ -4,7 +4,7 @@
 
 #include "amytiss/format.hpp"
 #include "execute.hpp"
-#include "host/reference_engine.hpp"
+#include "serial/reference_engine.hpp"
 #include "opencl/device.hpp"
 #include "opencl/layout.hpp"
 #include "plan.hpp"

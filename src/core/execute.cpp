@@ -1,9 +1,9 @@
 #include "execute.hpp"
 
 #include "amytiss/errors.hpp"
-#include "host/backward_driver.hpp"
-#include "host/reference_engine.hpp"
-#include "host/system_engine.hpp"
+#include "solve/backward_driver.hpp"
+#include "serial/reference_engine.hpp"
+#include "bounds/system_engine.hpp"
 #include "opencl/engine.hpp"
 #include "scale_out/team_dense.hpp"
 #include "scale_out/team_factored.hpp"

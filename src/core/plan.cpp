@@ -5,7 +5,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
-#include "host/system_engine.hpp"
+#include "bounds/system_engine.hpp"
 #include "opencl/layout.hpp"
 #include "opencl/run.hpp"
 #include "opencl/sweep_choice.hpp"

@@ -11,9 +11,9 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
-#include "host/robust_reference.hpp"
+#include "bounds/cell_roles.hpp"
 #include "opencl/device.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "scale_out/team.hpp"
 
 namespace amytiss::detail {

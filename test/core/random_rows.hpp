@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "host/interval_bellman.hpp"
+#include "bounds/omax/robust_expectation.hpp"
 
 namespace amytiss::test_rows {
 

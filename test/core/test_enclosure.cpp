@@ -18,7 +18,8 @@
 #include "amytiss/expression.hpp"
 #include "amytiss/model.hpp"
 #include "enclosure_support.hpp"
-#include "host/enclosure_mean_box.hpp"
+#include "robust_oracle.hpp"
+#include "bounds/mean_box.hpp"
 #include "model/builtin_equations.hpp"
 #include "test_support.hpp"
 

@@ -10,7 +10,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 #include "opencl/factored/tables.hpp"
 #include "opencl/device.hpp"

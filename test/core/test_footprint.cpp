@@ -14,7 +14,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/footprint.hpp"
-#include "host/robust_reference.hpp"
+#include "bounds/cell_roles.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {

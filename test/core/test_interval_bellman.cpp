@@ -1,4 +1,4 @@
-// The robust Bellman step (host/interval_bellman.hpp): the O-maximisation against a hand-worked row
+// The robust Bellman step (bounds/omax/robust_expectation.hpp): the O-maximisation against a hand-worked row
 // and against enumeration of the vertices of random rows; joint rows as rounded products; the
 // product (orthogonal) bound against the joint one on random per-dimension bounds.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <limits>
 #include <random>
 
-#include "host/interval_bellman.hpp"
+#include "bounds/omax/robust_expectation.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {

@@ -50,8 +50,8 @@ TEST(Layout, CoreHeadersSourcesAndCliIncludeNoRos) {
 // The core's folders by layer (docs/engine.md): an include may read its own layer or one below.
 int layer_of(const std::string& folder) {
   static const std::vector<std::pair<std::string, int>> kLayers = {
-      {"common", 0}, {"model", 1},  {"config", 2},    {"host", 3},
-      {"io", 3},     {"opencl", 4}, {"scale_out", 5}, {"", 6}};  // "": src/core itself (plan, engine)
+      {"common", 0},  {"model", 1}, {"config", 2}, {"factored", 3}, {"solve", 3},     {"serial", 4},
+      {"bounds", 4},  {"io", 4},    {"opencl", 5}, {"scale_out", 6}, {"", 7}};  // "": src/core itself (plan, engine)
   for (const auto& [name, layer] : kLayers)
     if (folder == name) return layer;
   return -1;

@@ -1,4 +1,4 @@
-// Interval transition bounds per dimension (model/mass_bounds.hpp): the 1-d extrema of each law
+// Interval transition bounds per dimension (bounds/mass_bounds.hpp): the 1-d extrema of each law
 // against closed forms, soundness over sampled means and scales (every law, additive and
 // multiplicative), the union window and the mass leaving the grid or cut by the truncation.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <random>
 
 #include "amytiss/errors.hpp"
-#include "model/mass_bounds.hpp"
+#include "bounds/mass_bounds.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {

@@ -1,4 +1,4 @@
-// The product bound over whole tables (host/product_sweep.hpp): one O-maximisation over a line of
+// The product bound over whole tables (bounds/product/whole_tables.hpp): one O-maximisation over a line of
 // known order gives robust_expectation()'s result bit for bit (the masked visit and the full scan,
 // ties, the leave and cut outcomes), and so do several lines at once; sort_line() is the stable
 // sort; the sweep gives
@@ -12,9 +12,9 @@
 #include <random>
 
 #include "amytiss/enclosure.hpp"
-#include "host/enclosure_mean_box.hpp"
-#include "host/product_sweep.hpp"
-#include "host/row_bounds.hpp"
+#include "bounds/mean_box.hpp"
+#include "bounds/product/whole_tables.hpp"
+#include "bounds/row_bounds.hpp"
 #include "random_rows.hpp"
 #include "test_support.hpp"
 

@@ -10,7 +10,7 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/engine.hpp"
-#include "host/robust_reference.hpp"
+#include "bounds/cell_roles.hpp"
 #include "test_support.hpp"
 
 namespace amytiss {

@@ -1,4 +1,4 @@
-// The product bound by variable elimination (host/robust_factored.hpp): every (cell, input,
+// The product bound by variable elimination (bounds/product/elimination.hpp): every (cell, input,
 // disturbance) gets product_expectation_in_order() of its row in the plan's order, within rounding,
 // with sorted lines and with unsorted ones, with tuples that share a window sharing a search, and
 // with a pair of stages run at once (a run of one stage's lines giving whole lines of the next);
@@ -15,10 +15,10 @@
 
 #include "amytiss/enclosure.hpp"
 #include "amytiss/engine.hpp"
-#include "host/enclosure_mean_box.hpp"
-#include "host/interval_step.hpp"
-#include "host/robust_factored.hpp"
-#include "host/robust_reference.hpp"
+#include "bounds/mean_box.hpp"
+#include "bounds/robust_step.hpp"
+#include "bounds/product/elimination.hpp"
+#include "bounds/cell_roles.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {
@@ -209,7 +209,7 @@ TEST(RobustFactored, StepTakesVariableEliminationAndStaysWithinTheJointBounds) {
   const Abstraction a = from_yaml(narrow_2d_yaml());
   const ImageEnclosure enclosure(a.config);
   const RowBounds rows = all_rows(a, enclosure);
-  IntervalStep step(a, rows, robust_cell_roles(a.states, a.config.spec, Bound::Lower), Bound::Lower,
+  RobustStep step(a, rows, robust_cell_roles(a.states, a.config.spec, Bound::Lower), Bound::Lower,
                     AmbiguitySet::Product, 2);
   EXPECT_NE(step.method().find("variable elimination"), std::string::npos) << step.method();
   // x'0 is counted fastest by x'1's lines: the two run as a pair, and the note says so.

@@ -11,7 +11,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "execute.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/engine_options.hpp"
 #include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/fused_stage.hpp"

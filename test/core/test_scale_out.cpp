@@ -12,7 +12,7 @@
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/device.hpp"
 #include "execute.hpp"
 #include "scale_out/partition.hpp"

@@ -1,4 +1,4 @@
-// The lines of the variable elimination's stages (host/stage_lines.hpp): counted line by line, the
+// The lines of the variable elimination's stages (bounds/product/stage_lines.hpp): counted line by line, the
 // cursor meets every line once, and with the free digits' combinations every output entry once;
 // found from a line's first input entry, it names the same line; the combinations' order counts
 // inputs and disturbances slowest.
@@ -6,8 +6,8 @@
 
 #include <algorithm>
 
-#include "host/robust_factored.hpp"
-#include "host/stage_lines.hpp"
+#include "bounds/product/elimination.hpp"
+#include "bounds/product/stage_lines.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {

@@ -1,6 +1,6 @@
 // Correctness of the continuous-system bounds (guarantee: system) as the robust reference computes
-// them from a configuration: image enclosures of its dynamics (host/enclosure_mean_box.hpp) fed to
-// the interval MDP (host/robust_reference.hpp, docs/semantics.md "Interval transition bounds").
+// them from a configuration: image enclosures of its dynamics (bounds/mean_box.hpp) fed to
+// the interval MDP (bounds/cell_roles.hpp, docs/semantics.md "Interval transition bounds").
 // - 1-d linear Gaussian reach-avoid whose sets cut cells (also with a disturbance, and with
 //   truncated windows): the continuous value of the served controller (the lower bound's, played
 //   by the cell that holds the state), by composite Simpson quadrature written here, lies between
@@ -27,8 +27,9 @@
 
 #include "amytiss/enclosure.hpp"
 #include "amytiss/engine.hpp"
-#include "host/enclosure_mean_box.hpp"
-#include "host/robust_reference.hpp"
+#include "robust_oracle.hpp"
+#include "bounds/mean_box.hpp"
+#include "bounds/cell_roles.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {

@@ -1,5 +1,5 @@
 // The engine of continuous-system bounds (guarantee: system): synthesize() gives the oracle's
-// bounds (host/robust_reference.hpp; product set with device auto, joint interval MDP with device
+// bounds (bounds/cell_roles.hpp; product set with device auto, joint interval MDP with device
 // reference) on bounded horizons, keeps lower <= upper, stores both in the policy file, answers
 // unbounded specifications with sound bounds, and the plan and validation refuse what it cannot run.
 #include <gtest/gtest.h>
@@ -14,8 +14,9 @@
 #include "amytiss/errors.hpp"
 #include "amytiss/grid.hpp"
 #include "amytiss/policy_file.hpp"
-#include "host/enclosure_mean_box.hpp"
-#include "host/robust_reference.hpp"
+#include "robust_oracle.hpp"
+#include "bounds/mean_box.hpp"
+#include "bounds/cell_roles.hpp"
 #include "test_support.hpp"
 
 namespace amytiss::detail {

@@ -1,4 +1,4 @@
-// The O-maximisation by its threshold (host/threshold_expectation.hpp): a sorted line holds an
+// The O-maximisation by its threshold (bounds/omax/threshold_expectation.hpp): a sorted line holds an
 // increasing order (line after line, neighbours and lines drawn afresh) and its windows' ranks;
 // from any starting rank,
 // on lines of every length (ranks as bits up to 128 cells, scanned beyond), with ties, cells
@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <random>
 
-#include "host/ordered_expectation.hpp"
-#include "host/threshold_expectation.hpp"
+#include "bounds/omax/ordered_expectation.hpp"
+#include "bounds/omax/threshold_expectation.hpp"
 #include "random_rows.hpp"
 
 namespace amytiss::detail {

@@ -13,6 +13,7 @@
 #include "opencl/program_cache.hpp"
 #include "opencl/run.hpp"
 #include "opencl/source.hpp"
+#include "serial/point_iteration.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -89,7 +90,7 @@ Policy run_dense(const Abstraction& a, const DeviceInfo& device, DeviceSession& 
 
   // Synthesis (Algorithm 4), V_{T_d} -> V_0, one padded step at a time back to the host.
   DenseStep step(a, layout, plan, buffers, session.queue.get(), sweep.get());
-  return run_backward(a, step, reporter);
+  return run_abstraction_backward(a, step, reporter);
 }
 
 }  // namespace

@@ -7,10 +7,10 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
 #include "amytiss/synthesis_types.hpp"
-#include "host/backward_driver.hpp"
+#include "solve/backward_driver.hpp"
 #include "opencl/device.hpp"
 #include "opencl/engine_options.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 
 namespace amytiss::detail {
 

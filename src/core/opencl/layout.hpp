@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
-#include "host/factored_plan.hpp"  // dense_window_width(), contraction_multiply_adds()
+#include "factored/factored_plan.hpp"  // dense_window_width(), contraction_multiply_adds()
 
 namespace amytiss::detail {
 

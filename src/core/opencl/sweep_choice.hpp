@@ -7,7 +7,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/layout.hpp"
 
 namespace amytiss::detail {

@@ -13,6 +13,7 @@
 #include "opencl/program_cache.hpp"
 #include "opencl/run.hpp"
 #include "opencl/source.hpp"
+#include "serial/point_iteration.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -139,7 +140,7 @@ Policy run_dense_team(const Abstraction& a, Team& team, const ComputeConfig& com
   std::vector<Member> members = set_up_members(a, layout, team, states, compute, engine_options, reporter);
   construct_all(a, team, members, reporter);
   DenseTeamStep step(a, layout, team, members, states);
-  Policy policy = run_backward(a, step, reporter);
+  Policy policy = run_abstraction_backward(a, step, reporter);
   team.report_exchange(exchange_bytes_per_step(a, layout), a.horizon, reporter.report());
   return policy;
 }

@@ -5,7 +5,7 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
-#include "host/backward_driver.hpp"
+#include "solve/backward_driver.hpp"
 #include "opencl/engine_options.hpp"
 #include "scale_out/team.hpp"
 

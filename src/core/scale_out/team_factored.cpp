@@ -13,6 +13,7 @@
 #include "amytiss/format.hpp"
 #include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/tables.hpp"
+#include "serial/point_iteration.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -197,7 +198,7 @@ Policy run_factored_team(const Abstraction& a, const FactoredPlan& plan, Team& t
   FactoredTeamStep step(a, plan, team, members, multiply_adds_per_step);
   for (const std::string& line : team.describe(step.states(), "input choice, states"))
     reporter.report().notes.push_back({NoteSeverity::Info, NoteKind::Sweep, line});
-  Policy policy = run_backward(a, step, reporter);
+  Policy policy = run_abstraction_backward(a, step, reporter);
   team.report_exchange(step.exchange_bytes(), a.horizon, reporter.report());
   return policy;
 }

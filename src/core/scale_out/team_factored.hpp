@@ -6,9 +6,9 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
-#include "host/backward_driver.hpp"
+#include "solve/backward_driver.hpp"
 #include "opencl/engine_options.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "scale_out/team.hpp"
 
 namespace amytiss::detail {

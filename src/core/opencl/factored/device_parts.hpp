@@ -8,7 +8,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
 #include "opencl/device.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "common/host_memory.hpp"
 #include "opencl/engine_options.hpp"
 #include "opencl/factored/program.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 
 namespace amytiss::detail {
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "amytiss/abstraction.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 
 namespace amytiss::detail {
 

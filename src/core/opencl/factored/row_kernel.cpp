@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "host/factored_layout.hpp"
+#include "factored/factored_layout.hpp"
 #include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/kernel_text.hpp"
 

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {

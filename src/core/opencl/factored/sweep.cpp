@@ -9,6 +9,7 @@
 #include "opencl/factored/device_parts.hpp"
 #include "opencl/factored/fused_stage.hpp"
 #include "opencl/factored/tables.hpp"
+#include "serial/point_iteration.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -150,7 +151,7 @@ Policy run_factored_sweep(const Abstraction& a, const FactoredPlan& plan, const 
   reporter.reached(Phase::Construction);
 
   FactoredStep step(a, plan, run, kernels, buffers, tables);
-  Policy policy = run_backward(a, step, reporter);
+  Policy policy = run_abstraction_backward(a, step, reporter);
   if (run.profile && !a.unbounded) step.report_breakdown(reporter, a.horizon);
   return policy;
 }

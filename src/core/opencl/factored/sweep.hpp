@@ -5,9 +5,9 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
-#include "host/backward_driver.hpp"
+#include "solve/backward_driver.hpp"
 #include "opencl/device.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 #include "opencl/factored/program.hpp"
 
 namespace amytiss::detail {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
-#include "host/factored_plan.hpp"
+#include "factored/factored_plan.hpp"
 
 namespace amytiss::detail {
 

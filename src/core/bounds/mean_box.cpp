@@ -1,0 +1,48 @@
+#include "bounds/mean_box.hpp"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace amytiss::detail {
+namespace {
+
+// The power of two at most 2^-40 of `width`, and the multiples of it just outside x. Floor and
+// ceiling of a quotient by a power of two are exact; a value of magnitude 2^52 quanta or more is
+// a multiple of the quantum already.
+double binary_quantum(double width) { return std::ldexp(1.0, std::ilogb(width) - 40); }
+double floor_to(double x, double quantum) {
+  return std::abs(x) < std::ldexp(quantum, 52) ? std::floor(x / quantum) * quantum : x;
+}
+double ceil_to(double x, double quantum) {
+  return std::abs(x) < std::ldexp(quantum, 52) ? std::ceil(x / quantum) * quantum : x;
+}
+
+}  // namespace
+
+MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,
+                           const Grid& disturbances) {
+  // Rounded outward to a binary grid far finer than the cell: boxes equal in exact arithmetic (a
+  // linear map on the grid gives many cells one mean) are then equal bit for bit, and share one
+  // entry of bounds and one search per line of the variable elimination.
+  std::vector<double> quanta;
+  for (double width : states.eta()) quanta.push_back(binary_quantum(width));
+  return [&enclosure, &states, &inputs, &disturbances, quanta](std::size_t cell, std::size_t input,
+                                                               std::size_t disturbance, double* lo, double* hi) {
+    const std::vector<double> centre = states.point(cell);
+    IntervalBox box;
+    for (std::size_t j = 0; j < centre.size(); ++j)
+      box.push_back(Interval(centre[j] - 0.5 * states.eta()[j], centre[j] + 0.5 * states.eta()[j]));
+    const std::vector<double> u = inputs.dims() ? inputs.point(input) : std::vector<double>{};
+    const std::vector<double> w = disturbances.dims() ? disturbances.point(disturbance) : std::vector<double>{};
+    const ImageBox image = enclosure.enclose(box, u, w);
+    constexpr double kInfinity = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < image.box.size(); ++i) {
+      const bool known = image.defined && !image.box[i].is_empty();
+      lo[i] = known ? floor_to(image.box[i].lo, quanta[i]) : -kInfinity;
+      hi[i] = known ? ceil_to(image.box[i].hi, quanta[i]) : kInfinity;
+    }
+  };
+}
+
+}  // namespace amytiss::detail

@@ -1,0 +1,18 @@
+#pragma once
+// The robust reference's mean boxes (bounds/cell_roles.hpp) from image enclosures of the
+// system map (amytiss/enclosure.hpp, docs/semantics.md "Image enclosures").
+#include "amytiss/enclosure.hpp"
+#include "amytiss/grid.hpp"
+#include "bounds/cell_roles.hpp"
+
+namespace amytiss::detail {
+
+/// For state cell `cell` of `states` (the box c +- eta/2 around its point), the points of `inputs`
+/// and `disturbances` (grids of no dimension: none), writes ImageEnclosure::enclose(), rounded
+/// outward to multiples of a power of two at most 2^-40 of the cell's width (per dimension). Where
+/// the map may be undefined in the cell the box is the whole space (-inf, +inf): every mass is then
+/// unknown. `enclosure` and the grids must outlive the returned function.
+MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,
+                           const Grid& disturbances);
+
+}  // namespace amytiss::detail

@@ -1,0 +1,125 @@
+#pragma once
+// The tests' oracle of the interval MDP: lower and upper bounds of the continuous system's
+// bounded-horizon value by a plain serial recursion over unpacked rows (docs/semantics.md,
+// "Interval transition bounds"), against which the bounds engine's methods are checked.
+//
+// For every x inside a Free cell (its interior), with the controller that plays controller[k][cell] at step k:
+//   lower(cell) <= P(the specification holds from x)   and, for every controller choosing inputs
+//   of the input grid, P(...) <= upper(cell),
+// against every disturbance of the disturbance grid (min over it, as the engines), provided
+// mean_box encloses f(x, u, w) for every x in the cell. Per (cell, input, disturbance) row and
+// dimension the bounds come from MassBounds (bounds/mass_bounds.hpp); the rows are the joint
+// interval MDP or the product set (bounds/omax/robust_expectation.hpp).
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "bounds/cell_roles.hpp"
+#include "bounds/mass_bounds.hpp"
+#include "bounds/omax/robust_expectation.hpp"
+
+namespace amytiss::detail {
+
+struct RobustProblem {
+  const Grid& states;
+  const Grid& inputs;        ///< zero dimensions: autonomous
+  const Grid& disturbances;  ///< zero dimensions: none
+  const NoiseModel& noise;   ///< separable (MassBounds refuses a full covariance)
+  MeanBox mean_box;
+  SpecType spec = SpecType::Safety;
+  unsigned horizon = 1;
+  std::vector<CellRole> lower_roles, upper_roles;  ///< robust_cell_roles() of each bound
+};
+
+struct RobustValues {
+  std::vector<double> lower, upper;       ///< V_0 bounds per state cell
+  std::vector<std::uint32_t> controller;  ///< [k * cells + cell]: the maximiser of the lower bound
+};
+
+namespace oracle_detail {
+
+inline double role_value(CellRole role, SpecType spec) {
+  if (role == CellRole::FixedOne) return 1.0;
+  if (role == CellRole::FixedZero) return 0.0;
+  return spec == SpecType::Safety ? 1.0 : 0.0;
+}
+
+// The bounds of every (cell, input, disturbance) row of the Free cells, per dimension.
+inline std::vector<std::vector<DimensionBounds>> oracle_row_bounds(const RobustProblem& p) {
+  const std::size_t dims = p.states.dims();
+  std::vector<MassBounds> per_dimension;
+  for (std::size_t d = 0; d < dims; ++d) per_dimension.emplace_back(p.noise, d);
+  const std::size_t inputs = p.inputs.size(), disturbances = p.disturbances.size();
+  std::vector<std::vector<DimensionBounds>> rows(p.states.size() * inputs * disturbances);
+  std::vector<double> lo(dims), hi(dims);
+  std::vector<std::size_t> multi(dims);
+  for (std::size_t cell = 0; cell < p.states.size(); ++cell) {
+    if (p.lower_roles[cell] != CellRole::Free && p.upper_roles[cell] != CellRole::Free) continue;
+    p.states.multi_index(cell, multi.data());
+    for (std::size_t u = 0; u < inputs; ++u) {
+      for (std::size_t w = 0; w < disturbances; ++w) {
+        p.mean_box(cell, u, w, lo.data(), hi.data());
+        std::vector<DimensionBounds>& row = rows[(cell * inputs + u) * disturbances + w];
+        for (std::size_t d = 0; d < dims; ++d) {
+          const auto k = std::int64_t(multi[d]);
+          const MassInterval scale = per_dimension[d].scale_range(p.states.face(d, k), p.states.face(d, k + 1));
+          row.push_back(per_dimension[d].dimension_bounds(p.states, lo[d], hi[d], scale.lo, scale.hi));
+        }
+      }
+    }
+  }
+  return rows;
+}
+}  // namespace oracle_detail
+
+/// Backward recursion over the horizon: lower = max_u min_w pessimistic expectation of the next
+/// lower values, upper = max_u min_w optimistic expectation of the next upper values; fixed cells
+/// hold their role's value, Free cells start at 1 (safety) or 0. Ties keep the lowest input.
+inline RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
+  const std::size_t cells = p.states.size(), inputs = p.inputs.size(), disturbances = p.disturbances.size();
+  const std::vector<std::vector<DimensionBounds>> rows = oracle_detail::oracle_row_bounds(p);
+  std::vector<IntervalRow> joint(set == AmbiguitySet::Joint ? rows.size() : 0);
+  for (std::size_t r = 0; r < joint.size(); ++r)
+    if (!rows[r].empty()) joint[r] = joint_row(p.states, rows[r]);
+  auto expectation = [&](std::size_t row, const std::vector<double>& values, Bound bound) {
+    return set == AmbiguitySet::Joint ? joint_expectation(joint[row], values.data(), bound)
+                                      : product_expectation(p.states, rows[row], values.data(), bound);
+  };
+
+  RobustValues out;
+  out.lower.resize(cells);
+  out.upper.resize(cells);
+  out.controller.assign(std::size_t(p.horizon) * cells, 0);
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    out.lower[cell] = oracle_detail::role_value(p.lower_roles[cell], p.spec);
+    out.upper[cell] = oracle_detail::role_value(p.upper_roles[cell], p.spec);
+  }
+  for (unsigned k = p.horizon; k-- > 0;) {
+    const std::vector<double> next_lower = out.lower, next_upper = out.upper;
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+      double best_lower = -1.0, best_upper = -1.0;
+      for (std::size_t u = 0; u < inputs; ++u) {
+        double worst_lower = std::numeric_limits<double>::infinity(), worst_upper = worst_lower;
+        for (std::size_t w = 0; w < disturbances; ++w) {
+          const std::size_t row = (cell * inputs + u) * disturbances + w;
+          if (p.lower_roles[cell] == CellRole::Free)
+            worst_lower = std::min(worst_lower, expectation(row, next_lower, Bound::Lower));
+          if (p.upper_roles[cell] == CellRole::Free)
+            worst_upper = std::min(worst_upper, expectation(row, next_upper, Bound::Upper));
+        }
+        if (p.lower_roles[cell] == CellRole::Free && worst_lower > best_lower) {
+          best_lower = worst_lower;
+          out.controller[std::size_t(k) * cells + cell] = std::uint32_t(u);
+        }
+        best_upper = std::max(best_upper, worst_upper);
+      }
+      if (p.lower_roles[cell] == CellRole::Free) out.lower[cell] = best_lower;
+      if (p.upper_roles[cell] == CellRole::Free) out.upper[cell] = best_upper;
+    }
+  }
+  return out;
+}
+
+}  // namespace amytiss::detail
