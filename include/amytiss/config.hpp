@@ -126,12 +126,21 @@ enum class TransitionStorage { Auto, Stored, OnTheFly };
 /// How the OpenCL engine computes the expected next values (docs/engine.md, "Two sweeps").
 enum class SweepChoice { Auto, Dense, Factored };
 
+/// How the continuous-system bounds (guarantee: system) compute each row's robust expectation
+/// (docs/engine.md, "The bounds' methods"). auto: whole tables where they pay, else variable
+/// elimination where it has a plan of one slice, else row by row; the others force that method.
+/// All product methods give the same bounds within their outward rounding; joint gives the looser
+/// bounds of the joint interval MDP (the oracle's set).
+enum class BoundsMethod { Auto, WholeTables, Elimination, Rows, Joint };
+
 struct ComputeConfig {
   DeviceKind device = DeviceKind::Auto;
   TransitionStorage transitions = TransitionStorage::Auto;
   /// auto: the factored sweep where the dynamics allow it and it saves at least half the
   /// multiply-adds, else dense; dense / factored: that one (factored that cannot run: error).
   SweepChoice sweep = SweepChoice::Auto;
+  /// guarantee: system only: the bounds' method (auto unless a test or a benchmark forces one).
+  BoundsMethod bounds_method = BoundsMethod::Auto;
   /// Optional OpenCL platform/device selection: a 0-based index ("1") or a case-insensitive
   /// substring of the platform or device name ("nvidia"). Empty: any.
   std::string platform;
@@ -203,6 +212,7 @@ struct ComputeOverrides {
   std::string device;       ///< auto | cpu | gpu | reference
   std::string transitions;  ///< auto | stored | on_the_fly
   std::string sweep;        ///< auto | dense | factored
+  std::string bounds_method;  ///< auto | whole_tables | elimination | rows | joint
   std::string platform;     ///< as compute.platform
   std::vector<std::string> devices;  ///< as compute.devices
   /// abstraction | system: the top-level key `guarantee` (errors name key_prefix + "guarantee",
@@ -243,6 +253,7 @@ std::string to_string(SpecType);
 std::string to_string(DeviceKind);
 std::string to_string(TransitionStorage);
 std::string to_string(SweepChoice);
+std::string to_string(BoundsMethod);
 std::string to_string(NoiseType);
 std::string to_string(Distribution);
 std::string to_string(Truncation);

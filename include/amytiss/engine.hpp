@@ -40,7 +40,8 @@ struct MemoryEstimate {
 MemoryEstimate estimate_memory(const Abstraction& abstraction);
 
 /// The serial reference engine directly, whatever the configuration's compute section says; for
-/// guarantee: system, the joint interval MDP's bounds (the oracle of the bounds engine).
+/// guarantee: system, the joint interval MDP's bounds on one thread (bounds_method joint: the
+/// oracle's set).
 Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallback& progress,
                             SynthesisReport* report = nullptr);
 

@@ -36,6 +36,7 @@ Config load_with_overrides(const Options& options) {
   overrides.device = options.device;
   overrides.transitions = options.transitions;
   overrides.sweep = options.sweep;
+  overrides.bounds_method = options.bounds_method;
   overrides.platform = options.platform;
   if (!options.devices.empty()) overrides.devices = split_list(options.devices);
   overrides.guarantee = options.guarantee;

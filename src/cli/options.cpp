@@ -18,6 +18,8 @@ const char* const kUsage =
     "  --device auto|cpu|gpu|reference    overrides compute.device\n"
     "  --transitions auto|stored|on_the_fly  overrides compute.transitions\n"
     "  --sweep auto|dense|factored        overrides compute.sweep (docs/engine.md)\n"
+    "  --bounds-method auto|whole_tables|elimination|rows|joint\n"
+    "                                     overrides compute.bounds_method (guarantee: system; docs/engine.md)\n"
     "  --platform NAME|INDEX              OpenCL platform/device: 0-based index or name substring\n"
     "  --devices all|LIST                 overrides compute.devices: several devices, comma-separated\n"
     "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
@@ -72,6 +74,7 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--device") options.device = value();
     else if (arg == "--transitions") options.transitions = value();
     else if (arg == "--sweep") options.sweep = value();
+    else if (arg == "--bounds-method") options.bounds_method = value();
     else if (arg == "--platform") options.platform = value();
     else if (arg == "--devices") options.devices = value();
     else if (arg == "--guarantee") options.guarantee = value();

@@ -21,6 +21,7 @@ struct Options {
   std::string device;       // empty: the configuration's
   std::string transitions;  // empty: the configuration's
   std::string sweep;        // empty: the configuration's
+  std::string bounds_method;  // empty: the configuration's
   std::string platform;
   std::string devices;      // empty: the configuration's
   std::string guarantee;    // empty: the configuration's

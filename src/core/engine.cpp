@@ -52,6 +52,7 @@ Policy synthesize_reference(const Abstraction& abstraction, const ProgressCallba
   if (abstraction.config.guarantee == Guarantee::System) {
     SynthesisOptions options;
     options.compute.device = DeviceKind::Reference;
+    options.compute.bounds_method = BoundsMethod::Joint;
     options.progress = progress;
     detail::SynthesisPlan plan = detail::plan_synthesis(abstraction, options);
     return detail::carry_out(abstraction, plan, options, {}, rep);

@@ -30,7 +30,7 @@ Policy carry_out(const Abstraction& a, SynthesisPlan& plan, const SynthesisOptio
   report.notes.insert(report.notes.end(), plan.notes.begin(), plan.notes.end());
   if (plan.engine == EngineKind::Reference) return run_reference(a, options.progress, report);
   StepReporter reporter(a, options.progress, report);
-  if (plan.engine == EngineKind::Bounds) return run_system_bounds(a, plan.bounds_set, reporter);
+  if (plan.engine == EngineKind::Bounds) return run_system_bounds(a, plan.bounds_method, plan.bounds_serial, reporter);
   if (plan.engine == EngineKind::Team) return run_team(a, plan, options, engine_options, reporter);
   return run_on_device(a, plan.device, plan.factored, options, engine_options, reporter);
 }

@@ -52,10 +52,15 @@ void plan_bounds(const SynthesisOptions& options, EngineScope scope, SynthesisPl
   if (!options.compute.devices.empty() || is_scale_out(options))
     throw ConfigError("compute.devices", std::string("several devices or ranks are not supported: expected ") + why);
   plan.engine = EngineKind::Bounds;
-  plan.bounds_set = options.compute.device == DeviceKind::Reference ? AmbiguitySet::Joint : AmbiguitySet::Product;
-  note(plan, plan.bounds_set == AmbiguitySet::Joint
-                 ? "guarantee: system, device reference: the joint interval MDP (the oracle; tiny problems)"
-                 : "guarantee: system: the product (orthogonally decoupled) interval MDP on the host's cores");
+  plan.bounds_method = options.compute.bounds_method;
+  plan.bounds_serial = options.compute.device == DeviceKind::Reference;
+  const std::string where = plan.bounds_serial ? "one host thread (device reference)" : "the host's cores";
+  note(plan, plan.bounds_method == BoundsMethod::Auto
+                 ? "guarantee: system: the interval MDP's bounds on " + where +
+                       ", method auto (once the row bounds are known: whole tables where they pay, else "
+                       "variable elimination, else row by row)"
+                 : "guarantee: system: the interval MDP's bounds on " + where + ", method " +
+                       to_string(plan.bounds_method) + " (compute.bounds_method)");
 }
 
 void plan_team(const Abstraction& a, const SynthesisOptions& options, SynthesisPlan& plan) {

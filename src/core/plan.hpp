@@ -11,7 +11,6 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/synthesis_types.hpp"
-#include "bounds/cell_roles.hpp"
 #include "opencl/device.hpp"
 #include "factored/factored_plan.hpp"
 #include "scale_out/team.hpp"
@@ -40,8 +39,10 @@ struct SynthesisPlan {
   std::optional<FactoredPlan> factored;  ///< OpenCL engines: the factored sweep when chosen, else dense
   double multiply_adds_per_step = 0;     ///< the planned work: the dense sweep's multiply-adds per time step
   bool may_fall_back = false;            ///< a failing device may be retried on the CPU device
-  /// Bounds: the joint interval MDP (device reference: the oracle) or the product set (auto).
-  AmbiguitySet bounds_set = AmbiguitySet::Product;
+  /// Bounds: the method asked for (compute.bounds_method; auto: chosen once the row bounds are
+  /// known, docs/engine.md) and whether on one thread (device reference) or the host's.
+  BoundsMethod bounds_method = BoundsMethod::Auto;
+  bool bounds_serial = false;
   std::vector<EngineNote> notes;         ///< the engine, devices and sweep chosen, and why
 };
 
@@ -61,8 +62,9 @@ enum class EngineScope { Any, OpenClOnly };
 /// engine when the planned work is small enough that an OpenCL kernel build would dominate, else
 /// the first GPU, else the CPU device; an explicit kind is honoured or refused. A request that
 /// cannot be honoured is a ConfigError naming its key; DeviceError when no OpenCL device answers.
-/// guarantee: system takes the Bounds engine (auto: product set; reference: joint) and refuses an
-/// OpenCL device or several devices with a ConfigError.
+/// guarantee: system takes the Bounds engine (auto: the host's threads; reference: one thread;
+/// the method from compute.bounds_method) and refuses an OpenCL device or several devices with a
+/// ConfigError.
 /// Opens a team's devices (collective over the ranks).
 SynthesisPlan plan_synthesis(const Abstraction& abstraction, const SynthesisOptions& options,
                              EngineScope scope = EngineScope::Any);

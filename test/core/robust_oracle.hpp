@@ -22,6 +22,10 @@
 
 namespace amytiss::detail {
 
+/// The rows' ambiguity sets: the joint interval MDP (each row's masses bounded cell by cell) or
+/// the product of the per-dimension sets (the bounds engine's product methods).
+enum class AmbiguitySet { Joint, Product };
+
 struct RobustProblem {
   const Grid& states;
   const Grid& inputs;        ///< zero dimensions: autonomous
@@ -31,11 +35,17 @@ struct RobustProblem {
   SpecType spec = SpecType::Safety;
   unsigned horizon = 1;
   std::vector<CellRole> lower_roles, upper_roles;  ///< robust_cell_roles() of each bound
+  /// The product set's elimination order (product_expectation_in_order()); empty: product_expectation()'s.
+  std::vector<std::size_t> order = {};
 };
 
 struct RobustValues {
   std::vector<double> lower, upper;       ///< V_0 bounds per state cell
   std::vector<std::uint32_t> controller;  ///< [k * cells + cell]: the maximiser of the lower bound
+  /// [k * cells + cell]: how far the maximiser's lower bound lies above the next best input's
+  /// (infinite with one input): an engine whose sums round otherwise may pick another input where
+  /// this is within its rounding.
+  std::vector<double> margin;
 };
 
 namespace oracle_detail {
@@ -84,14 +94,18 @@ inline RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
   for (std::size_t r = 0; r < joint.size(); ++r)
     if (!rows[r].empty()) joint[r] = joint_row(p.states, rows[r]);
   auto expectation = [&](std::size_t row, const std::vector<double>& values, Bound bound) {
-    return set == AmbiguitySet::Joint ? joint_expectation(joint[row], values.data(), bound)
-                                      : product_expectation(p.states, rows[row], values.data(), bound);
+    if (set == AmbiguitySet::Joint) return joint_expectation(joint[row], values.data(), bound);
+    if (p.order.empty()) return product_expectation(p.states, rows[row], values.data(), bound);
+    std::vector<DimensionView> views;
+    for (const DimensionBounds& dimension : rows[row]) views.push_back(view_of(dimension));
+    return product_expectation_in_order(p.states, views.data(), values.data(), bound, p.order);
   };
 
   RobustValues out;
   out.lower.resize(cells);
   out.upper.resize(cells);
   out.controller.assign(std::size_t(p.horizon) * cells, 0);
+  out.margin.assign(std::size_t(p.horizon) * cells, std::numeric_limits<double>::infinity());
   for (std::size_t cell = 0; cell < cells; ++cell) {
     out.lower[cell] = oracle_detail::role_value(p.lower_roles[cell], p.spec);
     out.upper[cell] = oracle_detail::role_value(p.upper_roles[cell], p.spec);
@@ -99,7 +113,7 @@ inline RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
   for (unsigned k = p.horizon; k-- > 0;) {
     const std::vector<double> next_lower = out.lower, next_upper = out.upper;
     for (std::size_t cell = 0; cell < cells; ++cell) {
-      double best_lower = -1.0, best_upper = -1.0;
+      double best_lower = -1.0, best_upper = -1.0, second_lower = -1.0;
       for (std::size_t u = 0; u < inputs; ++u) {
         double worst_lower = std::numeric_limits<double>::infinity(), worst_upper = worst_lower;
         for (std::size_t w = 0; w < disturbances; ++w) {
@@ -110,12 +124,17 @@ inline RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
             worst_upper = std::min(worst_upper, expectation(row, next_upper, Bound::Upper));
         }
         if (p.lower_roles[cell] == CellRole::Free && worst_lower > best_lower) {
+          second_lower = best_lower;
           best_lower = worst_lower;
           out.controller[std::size_t(k) * cells + cell] = std::uint32_t(u);
+        } else if (p.lower_roles[cell] == CellRole::Free) {
+          second_lower = std::max(second_lower, worst_lower);
         }
         best_upper = std::max(best_upper, worst_upper);
       }
       if (p.lower_roles[cell] == CellRole::Free) out.lower[cell] = best_lower;
+      if (p.lower_roles[cell] == CellRole::Free && inputs > 1)
+        out.margin[std::size_t(k) * cells + cell] = best_lower - second_lower;
       if (p.upper_roles[cell] == CellRole::Free) out.upper[cell] = best_upper;
     }
   }

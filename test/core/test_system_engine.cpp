@@ -1,6 +1,6 @@
 // The engine of continuous-system bounds (guarantee: system): synthesize() gives the oracle's
-// bounds (bounds/cell_roles.hpp; product set with device auto, joint interval MDP with device
-// reference) on bounded horizons, keeps lower <= upper, stores both in the policy file, answers
+// bounds (robust_oracle.hpp; the product set with method auto, the joint interval MDP with
+// method joint) on bounded horizons, keeps lower <= upper, stores both in the policy file, answers
 // unbounded specifications with sound bounds, and the plan and validation refuse what it cannot run.
 #include <gtest/gtest.h>
 
@@ -65,9 +65,12 @@ SynthesisOptions options_for(DeviceKind device) {
   return options;
 }
 
-void expect_matches_oracle(const std::string& yaml, DeviceKind device, AmbiguitySet set) {
+void expect_matches_oracle(const std::string& yaml, DeviceKind device, AmbiguitySet set,
+                           BoundsMethod method = BoundsMethod::Auto) {
   const Abstraction a = from_yaml(with_system(yaml));
-  const Policy policy = synthesize(a, options_for(device), nullptr);
+  SynthesisOptions options = options_for(device);
+  options.compute.bounds_method = method;
+  const Policy policy = synthesize(a, options, nullptr);
   const RobustValues expected = oracle(a, set);
   ASSERT_EQ(policy.guarantee, Guarantee::System);
   ASSERT_EQ(policy.upper_values.size(), policy.values.size());
@@ -87,8 +90,20 @@ TEST(SystemEngine, ProductEngineGivesTheOraclesBoundsAndController) {
   expect_matches_oracle(small_3d_yaml(3), DeviceKind::Auto, AmbiguitySet::Product);
 }
 
-TEST(SystemEngine, ReferenceDeviceGivesTheJointOraclesBounds) {
-  expect_matches_oracle(small_3d_yaml(2), DeviceKind::Reference, AmbiguitySet::Joint);
+TEST(SystemEngine, JointMethodGivesTheJointOraclesBounds) {
+  expect_matches_oracle(small_3d_yaml(2), DeviceKind::Reference, AmbiguitySet::Joint, BoundsMethod::Joint);
+  expect_matches_oracle(small_3d_yaml(2), DeviceKind::Auto, AmbiguitySet::Joint, BoundsMethod::Joint);
+}
+
+TEST(SystemEngine, ReferenceDeviceRunsTheProductSetOnOneThread) {
+  const Abstraction a = from_yaml(with_system(small_3d_yaml(2)));
+  SynthesisReport report;
+  const Policy serial = synthesize(a, options_for(DeviceKind::Reference), &report);
+  EXPECT_EQ(report.device, "reference");
+  const Policy threaded = synthesize(a, options_for(DeviceKind::Auto), nullptr);
+  EXPECT_EQ(serial.values, threaded.values);
+  EXPECT_EQ(serial.upper_values, threaded.upper_values);
+  EXPECT_EQ(serial.input_index, threaded.input_index);
 }
 
 TEST(SystemEngine, TheAbstractionLiesBetweenTheBoundsWhereSetsAlignWithCells) {

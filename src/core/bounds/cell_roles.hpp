@@ -12,8 +12,6 @@
 
 namespace amytiss::detail {
 
-enum class AmbiguitySet { Joint, Product };
-
 /// Writes lo[i] <= f(x, u, w)_i <= hi[i] (state units) for every x in state cell `cell` (flat
 /// index), input index `input` and disturbance index `disturbance`.
 using MeanBox = std::function<void(std::size_t cell, std::size_t input, std::size_t disturbance, double* lo,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace amytiss::detail {
 namespace {
@@ -22,25 +23,28 @@ std::vector<std::uint32_t> first_dimension_fastest(const Grid& states) {
 }  // namespace
 
 RobustStep::RobustStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles,
-                           Bound bound, AmbiguitySet set, unsigned threads,
-                           std::shared_ptr<SweepBuffers> sweep_buffers)
-    : a_(abstraction), rows_(rows), roles_(std::move(roles)), bound_(bound), set_(set), threads_(threads) {
+                       Bound bound, const MethodChoice& choice, unsigned threads,
+                       std::shared_ptr<SweepBuffers> sweep_buffers)
+    : a_(abstraction), rows_(rows), roles_(std::move(roles)), bound_(bound), choice_(choice), threads_(threads) {
   const std::size_t dims = a_.states.dims();
   stage_caches_.resize(dims);
   stage_cache_entries_.assign(dims, 0);
-  if (set_ != AmbiguitySet::Product) return;
-  if (ProductSweep::pays(a_.states, rows_, a_.triples())) {
-    sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_, std::move(sweep_buffers));
-    last_choice_.assign(a_.states.size(), kNoChoice);
-    visit_order_ = first_dimension_fastest(a_.states);
-    return;
-  }
-  if (std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a_, &no_elimination_)) {
-    std::vector<bool> has_rows(roles_.size());
-    for (std::size_t cell = 0; cell < roles_.size(); ++cell) has_rows[cell] = roles_[cell] == CellRole::Free;
-    factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, std::move(*plan), bound_, threads_,
-                                                      std::move(sweep_buffers));
-    return;
+  switch (choice_.method) {
+    case BoundsMethod::Joint: return;
+    case BoundsMethod::WholeTables:
+      sweep_ = std::make_unique<ProductSweep>(a_.states, rows_, bound_, threads_, std::move(sweep_buffers));
+      last_choice_.assign(a_.states.size(), kNoChoice);
+      visit_order_ = first_dimension_fastest(a_.states);
+      return;
+    case BoundsMethod::Elimination: {
+      std::vector<bool> has_rows(roles_.size());
+      for (std::size_t cell = 0; cell < roles_.size(); ++cell) has_rows[cell] = roles_[cell] == CellRole::Free;
+      factored_ = std::make_unique<RobustFactoredSweep>(a_, rows_, has_rows, *choice_.plan, bound_, threads_,
+                                                        std::move(sweep_buffers));
+      return;
+    }
+    case BoundsMethod::Rows: break;
+    case BoundsMethod::Auto: throw std::logic_error("RobustStep needs a method chosen by choose_bounds_method()");
   }
   // Deepest stages first: their lines are the most numerous and the most shared. A cache pays
   // when it has fewer entries than the lines the rows would compute (kLinesPerRow per row and
@@ -58,16 +62,15 @@ RobustStep::RobustStep(const Abstraction& abstraction, const RowBounds& rows, st
 }
 
 std::string RobustStep::method() const {
-  if (set_ == AmbiguitySet::Joint) return "the joint interval MDP row by row";
-  if (sweep_) return "the product set over whole tables";
-  if (!factored_) return "the product set row by row (no variable elimination: " + no_elimination_ + ")";
+  const std::string text = method_text(choice_.method) + " (" + choice_.reason;
+  if (!factored_) return text + ")";
   std::string order, pairs;
   for (std::size_t d : factored_->order()) order += " x'" + std::to_string(d);
   for (const RobustFactoredSweep::StageRun& run : factored_->runs())
     if (run.last > run.first)
       pairs += "; x'" + std::to_string(factored_->order()[run.first]) + " and x'" +
                std::to_string(factored_->order()[run.last]) + " as a pair";
-  return "the product set by variable elimination (eliminates" + order + pairs + ")";
+  return text + "; eliminates" + order + pairs + ")";
 }
 
 std::vector<std::pair<std::string, double>> RobustStep::stage_seconds() const {
@@ -104,7 +107,7 @@ double RobustStep::expectation(std::size_t row, const double* in, ProductScratch
   rows_.dimensions(row, views);
   for (std::size_t d = 1; d < scratch.caches.size(); ++d)
     if (scratch.caches[d].table) scratch.caches[d].row_class = rows_.suffix_class(row, d);
-  if (set_ == AmbiguitySet::Product) return product_expectation(a_.states, views, in, bound_, scratch);
+  if (choice_.method != BoundsMethod::Joint) return product_expectation(a_.states, views, in, bound_, scratch);
   return joint_expectation(joint_row(a_.states, views), in, bound_);
 }
 

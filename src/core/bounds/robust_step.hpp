@@ -16,6 +16,7 @@
 #include "bounds/product/whole_tables.hpp"
 #include "bounds/product/elimination.hpp"
 #include "bounds/cell_roles.hpp"
+#include "bounds/method.hpp"
 #include "bounds/row_bounds.hpp"
 
 namespace amytiss::detail {
@@ -27,8 +28,9 @@ class RobustStep : public BellmanStep {
   /// `roles`: the bound's cell roles (robust_cell_roles()); `rows` must hold every Free cell's rows.
   /// `sweep_buffers`: shared with the steps over the same rows that never run at the same time as
   /// this one (ProductSweep); null: its own.
+  /// `choice`: the method (choose_bounds_method()), the same for both bounds.
   RobustStep(const Abstraction& abstraction, const RowBounds& rows, std::vector<CellRole> roles, Bound bound,
-               AmbiguitySet set, unsigned threads, std::shared_ptr<SweepBuffers> sweep_buffers = nullptr);
+             const MethodChoice& choice, unsigned threads, std::shared_ptr<SweepBuffers> sweep_buffers = nullptr);
   void apply(const double* in, double* out, std::uint32_t* chosen) override;
   /// The step of one stationary controller (certification): out(x) = min_w of the bound's
   /// expectation with input controller[x]; fixed cells hold their role's value.
@@ -36,8 +38,9 @@ class RobustStep : public BellmanStep {
   /// The O-maximisation's outward rounding keeps the sequences apart by at most this.
   double resolution() const override { return 1e-12; }
   const std::vector<CellRole>& roles() const { return roles_; }
-  /// How the step computes the rows' bounds, for the notes: the product set over whole tables, by
-  /// variable elimination (with its order) or row by row, or the joint interval MDP.
+  BoundsMethod bounds_method() const { return choice_.method; }
+  /// How the step computes the rows' bounds, for the notes: the method, why, and the variable
+  /// elimination's order.
   std::string method() const;
   /// The variable elimination's stages, a pair as one ("stage 0 (x'1, all steps)", "stages 1-2
   /// (x'0 x'2, all steps)"), with their seconds over every step so far; empty without it.
@@ -63,7 +66,7 @@ class RobustStep : public BellmanStep {
   const RowBounds& rows_;
   std::vector<CellRole> roles_;
   Bound bound_;
-  AmbiguitySet set_;
+  MethodChoice choice_;
   unsigned threads_;
   // The product set's stages per (window line, suffix class), shared by the rows of one step
   // (ProductScratch::caches); per dimension, empty where it would not pay.
@@ -74,7 +77,6 @@ class RobustStep : public BellmanStep {
   // Else the product set by variable elimination where the factored sweep has a plan
   // (bounds/product/elimination.hpp); then no caches either.
   std::unique_ptr<RobustFactoredSweep> factored_;
-  std::string no_elimination_;  // why RobustFactoredSweep::plan() refused, where it did
   static constexpr std::uint32_t kNoChoice = ~std::uint32_t(0);
   std::vector<std::uint32_t> last_choice_;  // per cell, the input apply() chose last (sweep only)
   std::vector<std::uint32_t> visit_order_;  // the order apply() visits the cells in (sweep only)

@@ -5,17 +5,17 @@
 #include "amytiss/enclosure.hpp"
 #include "amytiss/format.hpp"
 #include "bounds/mean_box.hpp"
+#include "bounds/method.hpp"
 #include "bounds/robust_iteration.hpp"
 #include "bounds/robust_step.hpp"
 #include "bounds/row_bounds.hpp"
 
 namespace amytiss::detail {
 
-Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& reporter) {
-  const unsigned threads = set == AmbiguitySet::Joint ? 1u : host_threads();
-  reporter.set_device(set == AmbiguitySet::Joint ? "reference"
-                                                 : "host (" + std::to_string(threads) + " thread" +
-                                                       (threads == 1 ? "" : "s") + ")");
+Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial, StepReporter& reporter) {
+  const unsigned threads = serial ? 1u : host_threads();
+  reporter.set_device(serial ? "reference"
+                             : "host (" + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") + ")");
   reporter.reached(Phase::Setup);
   const auto construction_start = SteadyClock::now();
   std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
@@ -41,8 +41,9 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
   reporter.reached(Phase::Construction);
   // The backward driver runs the two bounds' steps one after the other: one set of sweep buffers.
   const auto sweep_buffers = std::make_shared<SweepBuffers>();
-  RobustStep lower(a, rows, std::move(lower_roles), Bound::Lower, set, threads, sweep_buffers);
-  RobustStep upper(a, rows, std::move(upper_roles), Bound::Upper, set, threads, sweep_buffers);
+  const MethodChoice choice = choose_bounds_method(a, rows, method);
+  RobustStep lower(a, rows, std::move(lower_roles), Bound::Lower, choice, threads, sweep_buffers);
+  RobustStep upper(a, rows, std::move(upper_roles), Bound::Upper, choice, threads, sweep_buffers);
   reporter.report().notes.push_back(
       {NoteSeverity::Info, NoteKind::Transitions,
        "continuous-system bounds: image enclosures of every cell, " + std::to_string(rows.intervals()) +

@@ -12,9 +12,10 @@
 
 namespace amytiss::detail {
 
-/// Lower and upper bounds over the joint interval MDP (the oracle) or the product set. The
-/// abstraction's configuration gives the system map (ImageEnclosure) and the sets.
-Policy run_system_bounds(const Abstraction& abstraction, AmbiguitySet set, StepReporter& reporter);
+/// Lower and upper bounds by `method` (Auto: choose_bounds_method()'s choice) on the host's
+/// threads, or on one thread when `serial` (device reference). The abstraction's configuration
+/// gives the system map (ImageEnclosure) and the sets.
+Policy run_system_bounds(const Abstraction& abstraction, BoundsMethod method, bool serial, StepReporter& reporter);
 
 /// Reach specifications: "891 of 60125 cells lie wholly inside the target (the lower bound's target
 /// cells)"; with none, also that the lower bound is then 0 everywhere and how to draw the target.

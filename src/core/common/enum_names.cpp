@@ -27,6 +27,15 @@ const std::vector<std::pair<const char*, SweepChoice>>& enum_names() {
   return names;
 }
 template <>
+const std::vector<std::pair<const char*, BoundsMethod>>& enum_names() {
+  static const std::vector<std::pair<const char*, BoundsMethod>> names = {{"auto", BoundsMethod::Auto},
+                                                                          {"whole_tables", BoundsMethod::WholeTables},
+                                                                          {"elimination", BoundsMethod::Elimination},
+                                                                          {"rows", BoundsMethod::Rows},
+                                                                          {"joint", BoundsMethod::Joint}};
+  return names;
+}
+template <>
 const std::vector<std::pair<const char*, NoiseType>>& enum_names() {
   static const std::vector<std::pair<const char*, NoiseType>> names = {{"additive", NoiseType::Additive},
                                                                        {"multiplicative", NoiseType::Multiplicative}};
@@ -102,6 +111,7 @@ std::string to_string(SpecType value) { return name_of(value); }
 std::string to_string(DeviceKind value) { return name_of(value); }
 std::string to_string(TransitionStorage value) { return name_of(value); }
 std::string to_string(SweepChoice value) { return name_of(value); }
+std::string to_string(BoundsMethod value) { return name_of(value); }
 std::string to_string(NoiseType value) { return name_of(value); }
 std::string to_string(Distribution value) { return name_of(value); }
 std::string to_string(Truncation value) { return name_of(value); }

@@ -15,6 +15,10 @@ void override_enum(Enum& value, const std::string& text, const std::string& key)
   value = *parsed;
 }
 
+bool default_prefix_of(const ComputeOverrides& overrides) {
+  return overrides.key_prefix == ComputeOverrides{}.key_prefix;
+}
+
 }  // namespace
 
 void apply_overrides(Config& config, const ComputeOverrides& overrides) {
@@ -22,10 +26,12 @@ void apply_overrides(Config& config, const ComputeOverrides& overrides) {
   override_enum(compute.device, overrides.device, overrides.key_prefix + "device");
   override_enum(compute.transitions, overrides.transitions, overrides.key_prefix + "transitions");
   override_enum(compute.sweep, overrides.sweep, overrides.key_prefix + "sweep");
+  override_enum(compute.bounds_method, overrides.bounds_method,
+                overrides.key_prefix + (default_prefix_of(overrides) ? "bounds_method" : "bounds-method"));
   if (!overrides.platform.empty()) compute.platform = overrides.platform;
   if (!overrides.devices.empty()) compute.devices = overrides.devices;
-  const bool default_prefix = overrides.key_prefix == ComputeOverrides{}.key_prefix;
-  override_enum(config.guarantee, overrides.guarantee, default_prefix ? "guarantee" : overrides.key_prefix + "guarantee");
+  override_enum(config.guarantee, overrides.guarantee,
+                default_prefix_of(overrides) ? "guarantee" : overrides.key_prefix + "guarantee");
 }
 
 }  // namespace amytiss

@@ -50,6 +50,9 @@ std::string unhashed_yaml(const Config& config) {
   text += "  device: " + to_string(compute.device) + "\n";
   text += "  transitions: " + to_string(compute.transitions) + "\n";
   text += "  sweep: " + to_string(compute.sweep) + "\n";
+  // Left out when it is the default, so files of configurations without the key keep their text.
+  if (compute.bounds_method != BoundsMethod::Auto)
+    text += "  bounds_method: " + to_string(compute.bounds_method) + "\n";
   text += "  platform: " + quoted(compute.platform) + "\n";
   text += "  device_name: " + quoted(compute.device_name) + "\n";
   text += "  memory_fraction: " + format_number(compute.memory_fraction) + "\n";

@@ -276,7 +276,13 @@ void check_compute(const ComputeConfig& compute) {
 
 // The continuous-system bounds are products of one-dimensional masses, computed on the host.
 void check_guarantee(const Config& config) {
-  if (config.guarantee != Guarantee::System) return;
+  if (config.guarantee != Guarantee::System) {
+    if (config.compute.bounds_method != BoundsMethod::Auto)
+      fail("compute.bounds_method", to_string(config.compute.bounds_method),
+           "auto with guarantee: abstraction (the bounds' methods are those of guarantee: system)",
+           "bounds_method: auto");
+    return;
+  }
   const std::size_t n = config.states.lb.size();
   const std::vector<double>& covariance = config.noise.covariance;
   if (covariance.size() == n * n && n > 1)

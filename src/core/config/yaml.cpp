@@ -229,11 +229,15 @@ std::vector<std::string> read_devices(const YAML::Node& devices) {
 
 ComputeConfig read_compute(const YAML::Node& compute) {
   check_keys(compute, "compute",
-             {"device", "transitions", "sweep", "platform", "device_name", "memory_fraction", "devices"},
+             {"device", "transitions", "sweep", "bounds_method", "platform", "device_name", "memory_fraction",
+              "devices"},
              "compute: {device: auto}");
   ComputeConfig config;
   if (present(compute["device"])) config.device = read_enum<DeviceKind>(compute["device"], "compute.device", "device: auto");
   if (present(compute["sweep"])) config.sweep = read_enum<SweepChoice>(compute["sweep"], "compute.sweep", "sweep: auto");
+  if (present(compute["bounds_method"]))
+    config.bounds_method =
+        read_enum<BoundsMethod>(compute["bounds_method"], "compute.bounds_method", "bounds_method: auto");
   if (present(compute["transitions"]))
     config.transitions =
         read_enum<TransitionStorage>(compute["transitions"], "compute.transitions", "transitions: auto");

@@ -15,16 +15,23 @@ constexpr std::size_t kScanLengthPerOutcome = 4;
 
 bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
   constexpr std::size_t kLinesPerRow = 64;
-  std::size_t entries = 0, prefixes = 1;
+  std::size_t prefixes = 1;
   for (std::size_t d = 0; d < states.dims(); ++d) {
     std::size_t window_cells = 0;
     for (std::uint32_t b = 0; b < rows.distinct_bounds(d); ++b) window_cells += rows.distinct(d, b).count + 2;
     if (states.count(d) * rows.distinct_bounds(d) > kScanLengthPerOutcome * window_cells) return false;
     if (d == 0) continue;
     prefixes *= states.count(d - 1);
-    const std::size_t stage = prefixes * rows.suffix_classes(d);
-    if (stage > kLinesPerRow * row_count) return false;
-    entries += stage;
+    if (prefixes * rows.suffix_classes(d) > kLinesPerRow * row_count) return false;
+  }
+  return fits(states, rows);
+}
+
+bool ProductSweep::fits(const Grid& states, const RowBounds& rows) {
+  std::size_t entries = 0, prefixes = 1;
+  for (std::size_t d = 1; d < states.dims(); ++d) {
+    prefixes *= states.count(d - 1);
+    entries += prefixes * rows.suffix_classes(d);
   }
   return entries <= kMaxTableEntries;
 }

@@ -40,6 +40,8 @@ class ProductSweep {
   /// is at most 4 times as long as its average window (a scan reads the whole line). Otherwise
   /// product_expectation() row by row is the cheaper way to the same results.
   static bool pays(const Grid& states, const RowBounds& rows, std::size_t row_count);
+  /// Whether its tables fit kMaxTableEntries (it can run, paying or not).
+  static bool fits(const Grid& states, const RowBounds& rows);
   /// `buffers`: shared with sweeps of the same rows that never run at the same time as this
   /// one; null: its own.
   ProductSweep(const Grid& states, const RowBounds& rows, Bound bound, unsigned threads,
