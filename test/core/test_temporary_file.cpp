@@ -1,6 +1,7 @@
 // Temporary files and their removal on fatal signals: commit and abandon, the signal handlers'
-// cases (default: remove and die; the program's own handler: called, nothing removed; ignored:
-// stays ignored; SIGXFSZ: the write fails instead), the dispositions restored afterwards, orphans.
+// cases (default, for every terminating signal: remove and die; the program's own handler:
+// called, nothing removed; ignored: stays ignored; SIGXFSZ: the write fails instead), the
+// dispositions restored afterwards, orphans.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -76,6 +77,26 @@ TEST_F(TemporaryFileTest, SigtermRemovesTheFileAndEndsTheProcess) {
   });
   EXPECT_TRUE(outcome.killed_by(SIGTERM)) << outcome.describe();
   EXPECT_TRUE(empty());
+}
+
+// Every catchable signal whose default action ends the process, but SIGXFSZ (below): a partial
+// file of 64 KiB is removed and the process still ends by that signal.
+TEST_F(TemporaryFileTest, EveryTerminatingSignalRemovesTheFileAndEndsTheProcess) {
+  for (const int signal_number : {SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2, SIGALRM, SIGPIPE, SIGXCPU,
+                                  SIGVTALRM, SIGPROF, SIGPOLL, SIGPWR}) {
+    SCOPED_TRACE(::strsignal(signal_number));
+    const auto outcome = run_in_child([&] {
+      const rlimit no_core{0, 0};  // SIGQUIT and SIGXCPU dump core by default
+      ::setrlimit(RLIMIT_CORE, &no_core);
+      ::signal(signal_number, SIG_DFL);
+      TemporaryFile file(path("p.h5"));
+      file.stream() << std::string(64 * 1024, 'x') << std::flush;
+      ::raise(signal_number);
+      return std::string("survived the signal");
+    });
+    EXPECT_TRUE(outcome.killed_by(signal_number)) << outcome.describe();
+    EXPECT_TRUE(empty());
+  }
 }
 
 TEST_F(TemporaryFileTest, AFileSizeLimitIsAnErrorNotTheEndOfTheProcess) {
