@@ -64,12 +64,13 @@ std::string read_string(const YAML::Node& node, const std::string& key, const st
   return node.Scalar();
 }
 
-// A count (number of steps, sub-steps): an integer that fits an unsigned 32-bit field. Whether
-// it is in range is validate()'s to judge.
-unsigned read_count(const YAML::Node& node, const std::string& key, const std::string& example) {
+// A count or an index: an integer that fits an unsigned 32-bit field. Whether it is in range is
+// validate()'s to judge; `expected` says what the key holds ("a positive integer").
+unsigned read_count(const YAML::Node& node, const std::string& key, const std::string& expected,
+                    const std::string& example) {
   const double value = read_number(node, key, example);
-  if (!(value >= 0 && value == std::floor(value) && value <= double(UINT32_MAX)))
-    fail(key, node.Scalar(), "an integer", example);
+  if (!(value >= 0 && value == std::floor(value))) fail(key, node.Scalar(), expected, example);
+  if (value > double(UINT32_MAX)) fail(key, node.Scalar(), expected + " <= " + std::to_string(UINT32_MAX), example);
   return static_cast<unsigned>(value);
 }
 
@@ -140,7 +141,7 @@ IntegratorConfig read_integrator(const YAML::Node& integrator) {
   if (present(integrator["method"]))
     config.method = read_enum<IntegrationMethod>(integrator["method"], "integrator.method", "method: rk4");
   if (present(integrator["substeps"]))
-    config.substeps = read_count(integrator["substeps"], "integrator.substeps", "substeps: 4");
+    config.substeps = read_count(integrator["substeps"], "integrator.substeps", "a positive integer", "substeps: 4");
   if (present(integrator["tau"])) config.tau = read_number(integrator["tau"], "integrator.tau", "tau: 0.1");
   return config;
 }
@@ -188,7 +189,8 @@ Footprint read_footprint(const YAML::Node& node) {
   const YAML::Node pose = required(node, "pose", "spec.footprint.pose", example);
   if (!pose.IsSequence()) fail("spec.footprint.pose", node_text(pose), "a list of state indices", example);
   for (std::size_t i = 0; i < pose.size(); ++i)
-    footprint.pose.push_back(read_count(pose[i], indexed("spec.footprint.pose", i), example));
+    footprint.pose.push_back(
+        read_count(pose[i], indexed("spec.footprint.pose", i), "a state index (an integer >= 0)", example));
   auto length_of = [&](const char* name) {
     const std::string key = std::string("spec.footprint.") + name;
     return read_number(required(node, name, key, example), key, example);
@@ -209,7 +211,8 @@ SpecConfig read_spec(const YAML::Node& spec) {
   if (horizon.IsScalar() && horizon.Scalar() == "infinite")
     config.unbounded = true;
   else
-    config.horizon = read_count(horizon, "spec.horizon", "horizon: 16 (or horizon: infinite)");
+    config.horizon =
+        read_count(horizon, "spec.horizon", "a positive integer or infinite", "horizon: 16 (or horizon: infinite)");
   if (present(spec["tolerance"])) config.tolerance = read_number(spec["tolerance"], "spec.tolerance", "tolerance: 1.0e-6");
   if (present(spec["safe"])) config.safe = read_region(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
   if (present(spec["target"])) config.target = read_region(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
