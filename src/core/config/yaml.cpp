@@ -1,10 +1,13 @@
 // Reading a configuration from YAML, one function per section: the key in every error, unknown
 // keys and wrong types refused; the values' meaning is judged by Config::validate()
 // (config/validate.cpp) and nowhere here.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <system_error>
+#include <vector>
 
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
@@ -266,6 +269,30 @@ YAML::Node parse_yaml_text(const std::string& text, const std::string& key) {
   }
 }
 
+// At most kMaxConfigFileBytes + 1 bytes are read, so a file that never ends (/dev/zero) or a huge
+// sparse one is refused without being held in memory.
+std::string read_config_text(const std::string& path) {
+  const char* const example = "config/robot_reach_avoid.yaml";
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw ConfigError(path, "got a directory, expected a configuration file (example: " + std::string(example) + ")");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw ConfigError(path, "cannot read the configuration file");
+  std::string text;
+  std::vector<char> chunk(64 * 1024);
+  while (text.size() <= kMaxConfigFileBytes) {
+    const std::size_t wanted = std::min(chunk.size(), kMaxConfigFileBytes + 1 - text.size());
+    if (file.read(chunk.data(), std::streamsize(wanted)).gcount() == 0) break;
+    text.append(chunk.data(), std::size_t(file.gcount()));
+  }
+  if (file.bad()) throw ConfigError(path, "cannot read the configuration file");
+  if (text.size() > kMaxConfigFileBytes)
+    throw ConfigError(path, "got a file of more than " + std::to_string(kMaxConfigFileBytes >> 20) +
+                                " MiB, expected a configuration of at most that size (example: " + example +
+                                ", a few KiB)");
+  return text;
+}
+
 }  // namespace
 
 Config read_config(const YAML::Node& root) {
@@ -304,11 +331,7 @@ Config config_from_yaml(const YAML::Node& root, const ComputeOverrides& override
 }
 
 Config load_config_file(const std::string& path, const ComputeOverrides& overrides) {
-  std::ifstream file(path);
-  if (!file) throw ConfigError(path, "cannot read the configuration file");
-  std::stringstream text;
-  text << file.rdbuf();
-  return config_from_yaml(parse_yaml_text(text.str(), path), overrides);
+  return config_from_yaml(parse_yaml_text(read_config_text(path), path), overrides);
 }
 
 Config read_stored_config(const std::string& yaml_text) {
