@@ -219,7 +219,8 @@ void apply_overrides(Config& config, const ComputeOverrides& overrides);
 
 /// Reads a YAML tree of the schema without judging the values: throws ConfigError naming the key
 /// only on a missing key, a wrong type (a text for a number, a fraction or a negative number for
-/// a count), an unknown enum value or an unknown key. Meaning is judged by Config::validate().
+/// a count), an unknown enum value, an unknown key or a key given twice (naming both lines).
+/// Meaning is judged by Config::validate().
 Config read_config(const YAML::Node& root);
 /// The one gate for user input: read_config, then apply_overrides, then Config::validate() once.
 Config config_from_yaml(const YAML::Node& root, const ComputeOverrides& overrides = {});

@@ -1,5 +1,5 @@
-// Reading a configuration file: a directory and a file over the size limit (also a huge sparse
-// one and one that never ends), each refused naming the file.
+// Reading a configuration file: a directory, a file over the size limit (also a huge sparse one
+// and one that never ends), and a key given twice, each refused naming the file or the key.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -57,6 +57,12 @@ std::string refusal_of(const std::string& file, const std::string& key) {
 }
 std::string refusal_of(const std::string& file) { return refusal_of(file, file); }
 
+std::string replaced(std::string text, const std::string& part, const std::string& by) {
+  const std::size_t at = text.find(part);
+  EXPECT_NE(std::string::npos, at) << part;
+  return text.replace(at, part.size(), by);
+}
+
 TEST_F(ConfigFileTest, ADirectoryIsRefusedAsADirectory) {
   const std::string message = refusal_of(directory_.string());
   EXPECT_NE(std::string::npos, message.find("got a directory, expected a configuration file")) << message;
@@ -82,6 +88,24 @@ TEST_F(ConfigFileTest, AFileOfExactlyTheSizeLimitIsRead) {
   text += std::string(kMaxConfigFileBytes - text.size() - 1, 'x') + "\n";
   ASSERT_EQ(kMaxConfigFileBytes, text.size());
   EXPECT_EQ("tiny", load_config_file(write("limit.yaml", text)).name);
+}
+
+// yaml-cpp keeps both entries and its lookup finds the first: the second was silently ignored.
+TEST_F(ConfigFileTest, AKeyGivenTwiceIsRefusedNamingTheKeyAndBothLines) {
+  const std::string file = write("twice.yaml", std::string(kTiny) + "guarantee: abstraction\n");
+  const std::string message = refusal_of(file, "guarantee");
+  EXPECT_NE(std::string::npos, message.find("guarantee: given twice (lines 12 and 13), expected each key once"))
+      << message;
+  using test_support::expect_error;
+  expect_error(YAML::Load(replaced(kTiny, "  horizon: 4\n", "  horizon: 4\n  horizon: 8\n")), "spec.horizon",
+               "given twice (lines 9 and 10)");
+  expect_error(YAML::Load(replaced(kTiny, "eta: [1, 1]}", "eta: [1, 1], lb: [0, 0]}")), "states.lb",
+               "given twice (lines 2 and 2)");
+  expect_error(YAML::Load(replaced(kTiny, "{tau: 1.0}", "{tau: 1.0, tau: 2.0}")), "constants.tau",
+               "given twice (lines 4 and 4)");
+  expect_error(YAML::Load(replaced(kTiny, "{lb: [-3, -3], ub", "{lb: [-3, -3], lb: [-3, -3], ub")),
+               "spec.avoid[1].lb", "given twice (lines 11 and 11)");
+  EXPECT_NO_THROW(load_config_file(write("once.yaml", kTiny)));
 }
 
 }  // namespace

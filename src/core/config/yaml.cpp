@@ -29,17 +29,35 @@ std::string node_text(const YAML::Node& node) {
   return "a map";
 }
 
+// " (lines 3 and 9)", or nothing for a tree not parsed from text (no positions).
+std::string lines_of(const YAML::Node& first, const YAML::Node& second) {
+  if (first.Mark().is_null() || second.Mark().is_null()) return "";
+  return " (lines " + std::to_string(first.Mark().line + 1) + " and " + std::to_string(second.Mark().line + 1) + ")";
+}
+
+// yaml-cpp keeps both entries of a repeated key and its lookup finds the first one: a second
+// `guarantee:` further down would be ignored without this check.
+void add_once(std::map<std::string, YAML::Node>& seen, const YAML::Node& name, const std::string& key) {
+  const auto [first, fresh] = seen.emplace(name.Scalar(), name);
+  if (!fresh)
+    throw ConfigError(key, "given twice" + lines_of(first->second, name) +
+                               ", expected each key once (remove one of them)");
+}
+
+std::string key_in(const std::string& key, const std::string& name) { return key.empty() ? name : key + "." + name; }
+
 void check_keys(const YAML::Node& node, const std::string& key, const std::vector<std::string>& allowed,
                 const std::string& example) {
   if (!node.IsMap()) fail(key, node_text(node), "a map", example);
+  std::map<std::string, YAML::Node> seen;
   for (const auto& entry : node) {
     const std::string name = entry.first.Scalar();
     bool known = false;
     for (const auto& candidate : allowed) known = known || candidate == name;
     if (!known)
-      throw ConfigError(key.empty() ? name : key + "." + name,
-                        "unknown key (valid keys" + (key.empty() ? std::string() : " of " + key) + ": " +
-                            join(allowed) + ")");
+      throw ConfigError(key_in(key, name), "unknown key (valid keys" + (key.empty() ? std::string() : " of " + key) +
+                                               ": " + join(allowed) + ")");
+    add_once(seen, entry.first, key_in(key, name));
   }
 }
 
@@ -131,8 +149,10 @@ std::map<std::string, double> read_constants(const YAML::Node& constants) {
   const char* const example = "constants: {tau: 10.0}";
   if (!constants.IsMap()) fail("constants", node_text(constants), "a map of names to numbers", example);
   std::map<std::string, double> values;
+  std::map<std::string, YAML::Node> seen;
   for (const auto& entry : constants) {
     const std::string name = entry.first.Scalar();
+    add_once(seen, entry.first, "constants." + name);
     values[name] = read_number(entry.second, "constants." + name, example);
   }
   return values;
