@@ -31,7 +31,13 @@ namespace amytiss {
 /// Writes atomically. Throws PolicyFileError on I/O failure, with the system's reason ("No space
 /// left on device", "Permission denied", ...); then no temporary file is left and an older file
 /// at `path` is intact.
+/// Only a regular file is replaced: a symbolic link is followed (its target is replaced, the link
+/// stays); a device, a FIFO or a socket at `path` (or as the link's target), or a link to a
+/// missing file, is refused with PolicyFileError and left as it is.
 void write_policy_file(const std::string& path, const Policy& policy, const Config& config);
+/// The refusals of write_policy_file for what is at `path` now (a device, a FIFO, a socket, a
+/// link to a missing file), as PolicyFileError: for a check before anything is computed.
+void check_policy_file_path(const std::string& path);
 
 struct LoadedPolicy {
   Policy policy;

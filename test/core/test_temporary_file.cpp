@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -56,6 +57,31 @@ TEST_F(TemporaryFileTest, CommitRenamesAndAbandoningRemoves) {
   }
   EXPECT_EQ("complete", text_of(path("out.txt")));
   EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+}
+
+// rename() would replace whatever is at the final path: a FIFO (or a device node, as root) would
+// become a file, and a symbolic link a file beside its target.
+TEST_F(TemporaryFileTest, OnlyRegularFilesAreReplacedAndALinkIsFollowedToItsTarget) {
+  ASSERT_EQ(0, ::mkfifo(path("fifo").c_str(), 0600));
+  try {
+    TemporaryFile file(path("fifo"));
+    ADD_FAILURE() << "a FIFO is replaced";
+  } catch (const FileWriteError& error) {
+    EXPECT_EQ("cannot write " + path("fifo") + ": it is a FIFO, not a regular file", std::string(error.what()));
+  }
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(path("fifo"))));
+  EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+
+  std::ofstream(path("target.txt")) << "older";
+  fs::create_symlink("target.txt", path("link.txt"));
+  {
+    TemporaryFile file(path("link.txt"));
+    EXPECT_EQ(fs::canonical(path("target.txt")).string(), file.final_path());
+    file.stream() << "newer";
+    file.commit();
+  }
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("link.txt"))));
+  EXPECT_EQ("newer", text_of(path("target.txt")));
 }
 
 TEST_F(TemporaryFileTest, AMissingFolderIsReportedWithItsReason) {
