@@ -1,7 +1,7 @@
 // amytiss_synth's refusals of hostile paths and option combinations, each with exit status 2
 // before anything is computed: a configuration that is a directory or never ends, --export with
 // the options of a synthesis, a state with a trailing comma, an --output that is not a regular
-// file (a symbolic link is followed instead).
+// file (a symbolic link is followed instead); and the documented layout of a system policy file.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -108,6 +108,21 @@ TEST_F(CliTest, AnOutputThatIsASymbolicLinkReplacesItsTarget) {
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("latest.h5"))));
   EXPECT_EQ("cli_tiny", read_stored_config(read_policy_file(path("runs/old.h5")).config_yaml).name);
   EXPECT_EQ(1, std::distance(fs::directory_iterator(path("runs")), fs::directory_iterator()));
+}
+
+// docs/policy_file.md lists the attribute `guarantee` and /upper_values of a bounded system file
+// as they are written.
+TEST_F(CliTest, ASystemPolicyFileHasTheDocumentedGuaranteeAndUpperValues) {
+  ASSERT_EQ(0, synth(kTiny + "--guarantee system --output system.h5").exit_code);
+  const CommandResult result =
+      run_in_directory("/usr/bin/python3 " + quote(kSourceDir + "/scripts/inspect_policy.py") + " system.h5");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "attribute guarantee = system");
+  EXPECT_CONTAINS(result.out, "dataset /values float64 (5, 9, 9)");
+  EXPECT_CONTAINS(result.out, "dataset /upper_values float64 (5, 9, 9)");
+  const std::string doc = test_support::read_file(kSourceDir + "/docs/policy_file.md");
+  EXPECT_CONTAINS(doc, "| `guarantee` | string | only with `guarantee: system`");
+  EXPECT_CONTAINS(doc, "| `/upper_values` | as `/values` | (horizon+1, n0, n1, ...) with `guarantee = system`");
 }
 
 }  // namespace
