@@ -3,9 +3,10 @@
 
 usage: inspect_policy.py POLICY.h5
 
-Prints the root attributes, then one line per dataset: its path, element type and shape, and
-a V_0 summary. Filters follow the shape: shuffle, gzip(level), fletcher32. Exits 1 when the file is not an amytiss policy. Used by test_cli to show that
-Python opens the files the C++ core writes.
+Prints the root attributes (those every file has, then the optional ones present, sorted), then
+one line per dataset: its path, element type and shape, and a V_0 summary. Filters follow the
+shape: shuffle, gzip(level), fletcher32. Exits 1 when the file is not an amytiss policy. Used by
+test_cli to show that Python opens the files the C++ core writes.
 """
 import sys
 
@@ -26,8 +27,12 @@ def main(argv):
         if text(attributes.get("format", "")) != "amytiss-policy":
             print(f"error: {argv[1]} is not an amytiss policy", file=sys.stderr)
             return 1
-        for name in ("format", "format_version", "config_hash", "computed_by", "run_id", "engine_version",
-                     "horizon", "spec", "content_digest"):
+        required = ("format", "format_version", "config_hash", "computed_by", "run_id", "engine_version",
+                    "horizon", "spec", "content_digest")
+        for name in required:
+            print(f"attribute {name} = {text(attributes[name])}")
+        # The attributes only some files have (stationary, iterations, converged, guarantee).
+        for name in sorted(set(attributes) - set(required)):
             print(f"attribute {name} = {text(attributes[name])}")
 
         datasets = []

@@ -1,6 +1,7 @@
 #pragma once
 // The one configuration of a synthesis problem (docs/configuration.md). The same schema is read from a
 // YAML file (CLI) and from ROS parameters (the ROS layer converts its XmlRpc tree to YAML::Node).
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -228,12 +229,16 @@ void apply_overrides(Config& config, const ComputeOverrides& overrides);
 
 /// Reads a YAML tree of the schema without judging the values: throws ConfigError naming the key
 /// only on a missing key, a wrong type (a text for a number, a fraction or a negative number for
-/// a count), an unknown enum value or an unknown key. Meaning is judged by Config::validate().
+/// a count), an unknown enum value, an unknown key or a key given twice (naming both lines).
+/// Meaning is judged by Config::validate().
 Config read_config(const YAML::Node& root);
 /// The one gate for user input: read_config, then apply_overrides, then Config::validate() once.
 Config config_from_yaml(const YAML::Node& root, const ComputeOverrides& overrides = {});
-/// config_from_yaml of a YAML file (ConfigError with key "<file>" when it cannot be read or is
-/// not YAML).
+/// The largest configuration file load_config_file reads: 16 MiB (the shipped examples are a few
+/// KiB).
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t(16) << 20;
+/// config_from_yaml of a YAML file (ConfigError with key "<file>" when it cannot be read, is a
+/// directory, is larger than kMaxConfigFileBytes, or is not YAML).
 Config load_config_file(const std::string& path, const ComputeOverrides& overrides = {});
 /// A configuration this program stored beside its result (a policy file's configuration text,
 /// to_yaml()), read without judging it again: it was validated before the result was computed,

@@ -11,10 +11,12 @@
 //                      the narrowest type for the grid's inputs
 //   /input_values      float64 (n_inputs, input_dims)      the input grid's points
 //   /roles             uint8   (n0, n1, ...)  0 free, 1 fixed zero (avoid/unsafe), 2 fixed one (target)
-// An unbounded specification's stationary policy (horizon 1) adds the attributes stationary = 1
-// and iterations (interval iterations done), and /upper_values (n0, n1, ...), of the type of
-// /values (float32 rounded up): the upper bound of the optimal value; /values[0] (= /values[1])
-// holds the certified lower bound.
+// An unbounded specification's stationary policy (horizon 1) adds the attributes stationary = 1,
+// iterations (interval iterations done) and converged, and /upper_values (n0, n1, ...), of the
+// type of /values (float32 rounded up): the upper bound of the optimal value; /values[0]
+// (= /values[1]) holds the certified lower bound. Continuous-system bounds (guarantee: system)
+// add the attribute guarantee = "system" and /upper_values, of shape (horizon+1, n0, n1, ...) for
+// a bounded horizon (stationary: (n0, n1, ...)): /values the lower, /upper_values the upper bounds.
 // Every non-empty array is chunked with HDF5's Fletcher-32 checksum; the large ones are also
 // shuffled and deflated. The file is built in memory,
 // written to "<path>.tmp.<pid>", flushed and renamed, so a reader never sees half a file; a
@@ -31,7 +33,13 @@ namespace amytiss {
 /// Writes atomically. Throws PolicyFileError on I/O failure, with the system's reason ("No space
 /// left on device", "Permission denied", ...); then no temporary file is left and an older file
 /// at `path` is intact.
+/// Only a regular file is replaced: a symbolic link is followed (its target is replaced, the link
+/// stays); a device, a FIFO or a socket at `path` (or as the link's target), or a link to a
+/// missing file, is refused with PolicyFileError and left as it is.
 void write_policy_file(const std::string& path, const Policy& policy, const Config& config);
+/// The refusals of write_policy_file for what is at `path` now (a device, a FIFO, a socket, a
+/// link to a missing file), as PolicyFileError: for a check before anything is computed.
+void check_policy_file_path(const std::string& path);
 
 struct LoadedPolicy {
   Policy policy;

@@ -55,6 +55,21 @@ void check_state_option(const Options& options, const Grid& states) {
                      " lies outside the grid (states.lb - eta/2 to states.ub + eta/2)");
 }
 
+std::string output_path(const Options& options, const Config& config) {
+  return options.output.empty() ? config.name + ".h5" : options.output;
+}
+
+// --output too is checked before anything is computed: a device or a FIFO there is refused.
+void check_output_option(const Options& options, const Config& config) {
+  if (options.dry_run || !options.export_format.empty()) return;
+  try {
+    check_policy_file_path(output_path(options, config));
+  } catch (const PolicyFileError& error) {
+    throw UsageError(std::string("--output: ") + error.what() +
+                     "; policy files are written only to regular files (example: --output policy.h5)");
+  }
+}
+
 void print_problem(const Options& options, const Config& config, const Abstraction& abstraction) {
   std::printf("configuration: %s (%s, %s), hash %s\n", config.name.c_str(), options.config_path.c_str(),
               to_string(config.spec.type).c_str(), config_hash(config).c_str());
@@ -101,7 +116,7 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
 
   // Collective: every rank has finished its part before rank 0 writes the one file.
   print_rank_times(synthesis_wall_seconds, report, mpi.communicator());
-  const std::string output = options.output.empty() ? config.name + ".h5" : options.output;
+  const std::string output = output_path(options, config);
   const auto write_start = SteadyClock::now();
   if (mpi.rank() == 0) write_policy_file(output, policy, config);
   const double write_seconds = seconds_since(write_start);
@@ -136,6 +151,7 @@ int run(const Options& options, cli::MpiSession& mpi) {
   }
   const auto setup_start = SteadyClock::now();
   const Config config = load_with_overrides(options);
+  check_output_option(options, config);
   const Abstraction abstraction = Abstraction::from_config(config);
   const double setup_seconds = seconds_since(setup_start);
   check_state_option(options, abstraction.states);

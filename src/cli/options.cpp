@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace amytiss::cli {
@@ -46,6 +47,10 @@ namespace {
 // "0.25,0.5,1.47" -> {0.25, 0.5, 1.47}; UsageError for an item that is not a finite number.
 std::vector<double> parse_state(const std::string& text) {
   std::vector<double> state;
+  // getline drops an empty last item: "1,1," would pass as "1,1".
+  if (!text.empty() && text.back() == ',')
+    throw UsageError("--at: got '" + text + "', expected the state's values separated by commas, without a comma "
+                     "at the end (example: --at 0.25,0.5,1.47)");
   std::stringstream stream(text);
   for (std::string item; std::getline(stream, item, ',');) {
     char* end = nullptr;
@@ -57,6 +62,22 @@ std::vector<double> parse_state(const std::string& text) {
   }
   if (state.empty()) throw UsageError("--at: got no values, expected the state's values (example: --at 0.25,0.5,1.47)");
   return state;
+}
+
+// An export writes the abstraction and exits: the options of a synthesis would be ignored.
+void check_export_alone(const Options& options) {
+  if (options.export_format.empty()) return;
+  const std::pair<bool, const char*> synthesis_options[] = {{options.dry_run, "--dry-run"},
+                                                            {!options.at.empty(), "--at"},
+                                                            {!options.output.empty(), "--output"},
+                                                            {options.profile, "--profile"},
+                                                            {options.compare_reference, "--compare-reference"}};
+  for (const auto& [given, name] : synthesis_options)
+    if (given)
+      throw UsageError(std::string("--export: got it with ") + name +
+                       ", expected --export without the options of a synthesis (--dry-run, --at, --output, "
+                       "--profile, --compare-reference): an export writes the abstraction and computes no policy "
+                       "(example: --config c.yaml --export prism out/)");
 }
 
 }  // namespace
@@ -102,6 +123,7 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--help" || arg == "-h") options.help = true;
     else throw UsageError("unknown option '" + arg + "' (see --help)");
   }
+  check_export_alone(options);
   if (!options.help && !options.list_devices && options.config_path.empty())
     throw UsageError("--config FILE is required (example: --config config/robot_safety.yaml)");
   return options;

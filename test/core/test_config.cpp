@@ -104,11 +104,13 @@ TEST(Config, WrongTypes) {
 
   root = base();
   root["spec"]["horizon"] = 2.5;
-  expect_error(root, "spec.horizon", "got 2.5, expected an integer");
+  expect_error(root, "spec.horizon", "got 2.5, expected a positive integer or infinite");
 
   root = base();
   root["spec"]["horizon"] = -3;
-  expect_error(root, "spec.horizon", "got -3");
+  expect_error(root, "spec.horizon", "got -3, expected a positive integer or infinite");
+  root["spec"]["horizon"] = -1;
+  expect_error(root, "spec.horizon", "got -1, expected a positive integer or infinite");
   root["spec"]["horizon"] = 4294967295u;
   expect_error(root, "spec.horizon", "got 4294967295, expected an integer >= 1 and <= 1000000000");
 }

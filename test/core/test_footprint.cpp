@@ -200,7 +200,8 @@ TEST(FootprintConfig, BadFootprintIsRefusedWithKeyValueAndExample) {
   expect_error(car_with("pose", "[0, 1, 3]"), "spec.footprint.pose[2]", "footprint: {pose: [0, 1, 2]");
   expect_error(car_with("pose", "[0, 1, 1]"), "spec.footprint.pose[2]", "other than spec.footprint.pose[1]");
   expect_error(car_with("pose", "[0, 1]"), "spec.footprint.pose", "3 state indices");
-  expect_error(car_with("pose", "[0, -1, 2]"), "spec.footprint.pose[1]", "an integer");
+  expect_error(car_with("pose", "[0, -1, 2]"), "spec.footprint.pose[1]",
+               "got -1, expected a state index (an integer >= 0)");
   expect_error(car_with("length", "1.0"), "spec.footprint.length", "> spec.footprint.rear_overhang = 1");
   expect_error(car_with("rear_overhang", "-0.5"), "spec.footprint.rear_overhang", ">= 0");
   expect_error(car_with("width", "0"), "spec.footprint.width", "> 0");

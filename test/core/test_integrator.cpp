@@ -144,7 +144,9 @@ TEST(Integrator, ValidationNamesTheKey) {
   expect_error(oscillator, 2, "{method: rk4, substeps: 4}", "integrator.tau", "vector field dx/dt");
   expect_error(oscillator, 2, "{method: midpoint, tau: 0.1}", "integrator.method", "one of euler, rk4");
   expect_error(oscillator, 2, "{substeps: 0, tau: 0.1}", "integrator.substeps", "an integer in [1, 100000]");
-  expect_error(oscillator, 2, "{substeps: 2.5, tau: 0.1}", "integrator.substeps", "got 2.5, expected an integer");
+  expect_error(oscillator, 2, "{substeps: 2.5, tau: 0.1}", "integrator.substeps",
+               "got 2.5, expected a positive integer");
+  expect_error(oscillator, 2, "{substeps: -1, tau: 0.1}", "integrator.substeps", "got -1, expected a positive integer");
   expect_error(oscillator, 2, "{tau: -0.1}", "integrator.tau", "a time step in seconds > 0");
   expect_error(oscillator, 2, "{tau: 0}", "integrator.tau", "a time step in seconds > 0");
   expect_error(oscillator, 2, "{steps: 2, tau: 0.1}", "integrator.steps", "unknown key");

@@ -1,9 +1,11 @@
 // Temporary files and their removal on fatal signals: commit and abandon, the signal handlers'
-// cases (default: remove and die; the program's own handler: called, nothing removed; ignored:
-// stays ignored; SIGXFSZ: the write fails instead), the dispositions restored afterwards, orphans.
+// cases (default, for every terminating signal: remove and die; the program's own handler:
+// called, nothing removed; ignored: stays ignored; SIGXFSZ: the write fails instead), the
+// dispositions restored afterwards, orphans.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -57,6 +59,31 @@ TEST_F(TemporaryFileTest, CommitRenamesAndAbandoningRemoves) {
   EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
 }
 
+// rename() would replace whatever is at the final path: a FIFO (or a device node, as root) would
+// become a file, and a symbolic link a file beside its target.
+TEST_F(TemporaryFileTest, OnlyRegularFilesAreReplacedAndALinkIsFollowedToItsTarget) {
+  ASSERT_EQ(0, ::mkfifo(path("fifo").c_str(), 0600));
+  try {
+    TemporaryFile file(path("fifo"));
+    ADD_FAILURE() << "a FIFO is replaced";
+  } catch (const FileWriteError& error) {
+    EXPECT_EQ("cannot write " + path("fifo") + ": it is a FIFO, not a regular file", std::string(error.what()));
+  }
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(path("fifo"))));
+  EXPECT_EQ(1, std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+
+  std::ofstream(path("target.txt")) << "older";
+  fs::create_symlink("target.txt", path("link.txt"));
+  {
+    TemporaryFile file(path("link.txt"));
+    EXPECT_EQ(fs::canonical(path("target.txt")).string(), file.final_path());
+    file.stream() << "newer";
+    file.commit();
+  }
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(path("link.txt"))));
+  EXPECT_EQ("newer", text_of(path("target.txt")));
+}
+
 TEST_F(TemporaryFileTest, AMissingFolderIsReportedWithItsReason) {
   try {
     TemporaryFile file(path("absent/out.txt"));
@@ -76,6 +103,26 @@ TEST_F(TemporaryFileTest, SigtermRemovesTheFileAndEndsTheProcess) {
   });
   EXPECT_TRUE(outcome.killed_by(SIGTERM)) << outcome.describe();
   EXPECT_TRUE(empty());
+}
+
+// Every catchable signal whose default action ends the process, but SIGXFSZ (below): a partial
+// file of 64 KiB is removed and the process still ends by that signal.
+TEST_F(TemporaryFileTest, EveryTerminatingSignalRemovesTheFileAndEndsTheProcess) {
+  for (const int signal_number : {SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2, SIGALRM, SIGPIPE, SIGXCPU,
+                                  SIGVTALRM, SIGPROF, SIGPOLL, SIGPWR}) {
+    SCOPED_TRACE(::strsignal(signal_number));
+    const auto outcome = run_in_child([&] {
+      const rlimit no_core{0, 0};  // SIGQUIT and SIGXCPU dump core by default
+      ::setrlimit(RLIMIT_CORE, &no_core);
+      ::signal(signal_number, SIG_DFL);
+      TemporaryFile file(path("p.h5"));
+      file.stream() << std::string(64 * 1024, 'x') << std::flush;
+      ::raise(signal_number);
+      return std::string("survived the signal");
+    });
+    EXPECT_TRUE(outcome.killed_by(signal_number)) << outcome.describe();
+    EXPECT_TRUE(empty());
+  }
 }
 
 TEST_F(TemporaryFileTest, AFileSizeLimitIsAnErrorNotTheEndOfTheProcess) {

@@ -1,10 +1,13 @@
 // Reading a configuration from YAML, one function per section: the key in every error, unknown
 // keys and wrong types refused; the values' meaning is judged by Config::validate()
 // (config/validate.cpp) and nowhere here.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <system_error>
+#include <vector>
 
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
@@ -26,17 +29,35 @@ std::string node_text(const YAML::Node& node) {
   return "a map";
 }
 
+// " (lines 3 and 9)", or nothing for a tree not parsed from text (no positions).
+std::string lines_of(const YAML::Node& first, const YAML::Node& second) {
+  if (first.Mark().is_null() || second.Mark().is_null()) return "";
+  return " (lines " + std::to_string(first.Mark().line + 1) + " and " + std::to_string(second.Mark().line + 1) + ")";
+}
+
+// yaml-cpp keeps both entries of a repeated key and its lookup finds the first one: a second
+// `guarantee:` further down would be ignored without this check.
+void add_once(std::map<std::string, YAML::Node>& seen, const YAML::Node& name, const std::string& key) {
+  const auto [first, fresh] = seen.emplace(name.Scalar(), name);
+  if (!fresh)
+    throw ConfigError(key, "given twice" + lines_of(first->second, name) +
+                               ", expected each key once (remove one of them)");
+}
+
+std::string key_in(const std::string& key, const std::string& name) { return key.empty() ? name : key + "." + name; }
+
 void check_keys(const YAML::Node& node, const std::string& key, const std::vector<std::string>& allowed,
                 const std::string& example) {
   if (!node.IsMap()) fail(key, node_text(node), "a map", example);
+  std::map<std::string, YAML::Node> seen;
   for (const auto& entry : node) {
     const std::string name = entry.first.Scalar();
     bool known = false;
     for (const auto& candidate : allowed) known = known || candidate == name;
     if (!known)
-      throw ConfigError(key.empty() ? name : key + "." + name,
-                        "unknown key (valid keys" + (key.empty() ? std::string() : " of " + key) + ": " +
-                            join(allowed) + ")");
+      throw ConfigError(key_in(key, name), "unknown key (valid keys" + (key.empty() ? std::string() : " of " + key) +
+                                               ": " + join(allowed) + ")");
+    add_once(seen, entry.first, key_in(key, name));
   }
 }
 
@@ -64,12 +85,13 @@ std::string read_string(const YAML::Node& node, const std::string& key, const st
   return node.Scalar();
 }
 
-// A count (number of steps, sub-steps): an integer that fits an unsigned 32-bit field. Whether
-// it is in range is validate()'s to judge.
-unsigned read_count(const YAML::Node& node, const std::string& key, const std::string& example) {
+// A count or an index: an integer that fits an unsigned 32-bit field. Whether it is in range is
+// validate()'s to judge; `expected` says what the key holds ("a positive integer").
+unsigned read_count(const YAML::Node& node, const std::string& key, const std::string& expected,
+                    const std::string& example) {
   const double value = read_number(node, key, example);
-  if (!(value >= 0 && value == std::floor(value) && value <= double(UINT32_MAX)))
-    fail(key, node.Scalar(), "an integer", example);
+  if (!(value >= 0 && value == std::floor(value))) fail(key, node.Scalar(), expected, example);
+  if (value > double(UINT32_MAX)) fail(key, node.Scalar(), expected + " <= " + std::to_string(UINT32_MAX), example);
   return static_cast<unsigned>(value);
 }
 
@@ -127,8 +149,10 @@ std::map<std::string, double> read_constants(const YAML::Node& constants) {
   const char* const example = "constants: {tau: 10.0}";
   if (!constants.IsMap()) fail("constants", node_text(constants), "a map of names to numbers", example);
   std::map<std::string, double> values;
+  std::map<std::string, YAML::Node> seen;
   for (const auto& entry : constants) {
     const std::string name = entry.first.Scalar();
+    add_once(seen, entry.first, "constants." + name);
     values[name] = read_number(entry.second, "constants." + name, example);
   }
   return values;
@@ -140,7 +164,7 @@ IntegratorConfig read_integrator(const YAML::Node& integrator) {
   if (present(integrator["method"]))
     config.method = read_enum<IntegrationMethod>(integrator["method"], "integrator.method", "method: rk4");
   if (present(integrator["substeps"]))
-    config.substeps = read_count(integrator["substeps"], "integrator.substeps", "substeps: 4");
+    config.substeps = read_count(integrator["substeps"], "integrator.substeps", "a positive integer", "substeps: 4");
   if (present(integrator["tau"])) config.tau = read_number(integrator["tau"], "integrator.tau", "tau: 0.1");
   return config;
 }
@@ -188,7 +212,8 @@ Footprint read_footprint(const YAML::Node& node) {
   const YAML::Node pose = required(node, "pose", "spec.footprint.pose", example);
   if (!pose.IsSequence()) fail("spec.footprint.pose", node_text(pose), "a list of state indices", example);
   for (std::size_t i = 0; i < pose.size(); ++i)
-    footprint.pose.push_back(read_count(pose[i], indexed("spec.footprint.pose", i), example));
+    footprint.pose.push_back(
+        read_count(pose[i], indexed("spec.footprint.pose", i), "a state index (an integer >= 0)", example));
   auto length_of = [&](const char* name) {
     const std::string key = std::string("spec.footprint.") + name;
     return read_number(required(node, name, key, example), key, example);
@@ -209,7 +234,8 @@ SpecConfig read_spec(const YAML::Node& spec) {
   if (horizon.IsScalar() && horizon.Scalar() == "infinite")
     config.unbounded = true;
   else
-    config.horizon = read_count(horizon, "spec.horizon", "horizon: 16 (or horizon: infinite)");
+    config.horizon =
+        read_count(horizon, "spec.horizon", "a positive integer or infinite", "horizon: 16 (or horizon: infinite)");
   if (present(spec["tolerance"])) config.tolerance = read_number(spec["tolerance"], "spec.tolerance", "tolerance: 1.0e-6");
   if (present(spec["safe"])) config.safe = read_region(spec["safe"], "spec.safe", "{lb: [-10, -10], ub: [10, 10]}");
   if (present(spec["target"])) config.target = read_region(spec["target"], "spec.target", "{lb: [5, 5], ub: [7, 7]}");
@@ -267,6 +293,30 @@ YAML::Node parse_yaml_text(const std::string& text, const std::string& key) {
   }
 }
 
+// At most kMaxConfigFileBytes + 1 bytes are read, so a file that never ends (/dev/zero) or a huge
+// sparse one is refused without being held in memory.
+std::string read_config_text(const std::string& path) {
+  const char* const example = "config/robot_reach_avoid.yaml";
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw ConfigError(path, "got a directory, expected a configuration file (example: " + std::string(example) + ")");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw ConfigError(path, "cannot read the configuration file");
+  std::string text;
+  std::vector<char> chunk(64 * 1024);
+  while (text.size() <= kMaxConfigFileBytes) {
+    const std::size_t wanted = std::min(chunk.size(), kMaxConfigFileBytes + 1 - text.size());
+    if (file.read(chunk.data(), std::streamsize(wanted)).gcount() == 0) break;
+    text.append(chunk.data(), std::size_t(file.gcount()));
+  }
+  if (file.bad()) throw ConfigError(path, "cannot read the configuration file");
+  if (text.size() > kMaxConfigFileBytes)
+    throw ConfigError(path, "got a file of more than " + std::to_string(kMaxConfigFileBytes >> 20) +
+                                " MiB, expected a configuration of at most that size (example: " + example +
+                                ", a few KiB)");
+  return text;
+}
+
 }  // namespace
 
 Config read_config(const YAML::Node& root) {
@@ -305,11 +355,7 @@ Config config_from_yaml(const YAML::Node& root, const ComputeOverrides& override
 }
 
 Config load_config_file(const std::string& path, const ComputeOverrides& overrides) {
-  std::ifstream file(path);
-  if (!file) throw ConfigError(path, "cannot read the configuration file");
-  std::stringstream text;
-  text << file.rdbuf();
-  return config_from_yaml(parse_yaml_text(text.str(), path), overrides);
+  return config_from_yaml(parse_yaml_text(read_config_text(path), path), overrides);
 }
 
 Config read_stored_config(const std::string& yaml_text) {

@@ -13,7 +13,10 @@
 namespace amytiss::detail {
 namespace {
 
-constexpr std::array<int, 5> kSignals{SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGXFSZ};
+// Not the signals a fault of the program raises (SIGSEGV, SIGBUS, ...): after a crash its state
+// cannot be trusted, and the next write to the path removes the orphan.
+constexpr std::array<int, 14> kSignals{SIGHUP,  SIGINT,  SIGQUIT, SIGTERM,   SIGXFSZ, SIGUSR1, SIGUSR2,
+                                       SIGALRM, SIGPIPE, SIGXCPU, SIGVTALRM, SIGPROF, SIGPOLL, SIGPWR};
 
 enum SlotState : int { kFree = 0, kClaimed = 1, kReady = 2 };
 

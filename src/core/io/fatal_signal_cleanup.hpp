@@ -1,8 +1,11 @@
 #pragma once
 // Removal of temporary files when a signal ends the process while they are being written.
 //
-// While at least one file is registered, handlers for SIGHUP, SIGINT, SIGQUIT, SIGTERM and
-// SIGXFSZ are installed. A signal whose previous disposition was the default (the process ends)
+// While at least one file is registered, handlers are installed for every signal whose default
+// action ends the process and that is not raised by a fault of the program itself: SIGHUP,
+// SIGINT, SIGQUIT, SIGTERM, SIGXFSZ, SIGUSR1, SIGUSR2, SIGALRM, SIGPIPE, SIGXCPU, SIGVTALRM,
+// SIGPROF, SIGPOLL and SIGPWR (not SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGABRT, SIGSYS, nor
+// the real-time signals). A signal whose previous disposition was the default (the process ends)
 // unlinks every registered file and is raised again with the default disposition, so the process
 // ends as it would have; a signal the program handles itself goes to its handler and removes
 // nothing (the program goes on and the writer cleans up); an ignored signal stays ignored.

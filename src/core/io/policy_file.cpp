@@ -14,6 +14,14 @@ void write_policy_file(const std::string& path, const Policy& policy, const Conf
   detail::write_policy_file_as(path, policy, config, detail::kPolicyFormatName, detail::kPolicyFormatVersion);
 }
 
+void check_policy_file_path(const std::string& path) {
+  try {
+    detail::replaceable_path(path);
+  } catch (const detail::FileWriteError& error) {
+    throw PolicyFileError(error.what());
+  }
+}
+
 namespace detail {
 void write_policy_file_as(const std::string& path, const Policy& policy, const Config& config,
                           const std::string& format, unsigned format_version, unsigned engine_version) {

@@ -2,11 +2,14 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <streambuf>
 #include <vector>
 
@@ -28,7 +31,33 @@ pid_t writer_pid(const std::string& name, const std::string& prefix) {
   return pid_t(std::stol(digits));
 }
 
+const char* kind_of(mode_t mode) {
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return nullptr;
+}
+
 }  // namespace
+
+std::string replaceable_path(const std::string& path) {
+  struct stat status {};
+  // Nothing there or not reachable: creating the temporary file reports why.
+  if (::lstat(path.c_str(), &status) != 0) return path;
+  if (const char* kind = kind_of(status.st_mode))
+    throw FileWriteError("cannot write " + path + ": it is " + kind + ", not a regular file");
+  if (!S_ISLNK(status.st_mode)) return path;
+  struct stat target {};
+  if (::stat(path.c_str(), &target) != 0)
+    throw FileWriteError("cannot write " + path + ": it is a symbolic link to a missing file (" +
+                         std::strerror(errno) + ")");
+  if (const char* kind = kind_of(target.st_mode))
+    throw FileWriteError("cannot write " + path + ": it is a symbolic link to " + kind + ", not to a regular file");
+  std::unique_ptr<char, decltype(&std::free)> resolved(::realpath(path.c_str(), nullptr), &std::free);
+  if (!resolved) throw FileWriteError("cannot write " + path + ": " + std::strerror(errno));
+  return resolved.get();
+}
 
 std::size_t remove_orphaned_temporaries(const std::string& final_path) {
   namespace fs = std::filesystem;
@@ -102,8 +131,10 @@ class TemporaryFile::Buffer : public std::streambuf {
   std::vector<char> buffer_;
 };
 
-TemporaryFile::TemporaryFile(std::string final_path)
-    : final_path_(std::move(final_path)), temporary_path_(temporary_name(final_path_)), cleanup_(temporary_path_) {
+TemporaryFile::TemporaryFile(const std::string& final_path)
+    : final_path_(replaceable_path(final_path)),
+      temporary_path_(temporary_name(final_path_)),
+      cleanup_(temporary_path_) {
   remove_orphaned_temporaries(final_path_);
   const int descriptor = ::open(temporary_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (descriptor < 0) fail("create", errno);

@@ -1,7 +1,8 @@
 #pragma once
 // A file written under a temporary name next to its final path and renamed into place only when
 // it is complete, so a reader never sees half a file and a failed write leaves the previous file
-// intact. The temporary name is "<final path>.tmp.<pid>".
+// intact. The temporary name is "<final path>.tmp.<pid>". Only regular files are replaced: a
+// symbolic link is followed to its target, and a device, a FIFO or a socket is refused.
 //
 //   TemporaryFile file("out/model.tra");   // removes orphans of dead processes, creates the file
 //   file.stream() << ...;                  // buffered; a failed write makes the stream bad
@@ -30,11 +31,19 @@ class FileWriteError : public std::runtime_error {
 /// be removed stay. Returns the number removed.
 std::size_t remove_orphaned_temporaries(const std::string& final_path);
 
+/// The path a write to `path` replaces: `path` itself, or, for a symbolic link, the canonical
+/// path of its target, so the link stays and its target is replaced. Throws FileWriteError naming
+/// `path` when it is (or links to) a character or block device, a FIFO or a socket, or is a link
+/// to a missing file. Anything else (nothing there, a regular file, a directory: the rename
+/// fails) is left to the write.
+std::string replaceable_path(const std::string& path);
+
 class TemporaryFile {
  public:
-  /// Removes orphans (remove_orphaned_temporaries), then creates the temporary file (mode 0666
-  /// less the umask). Throws FileWriteError when it cannot be created.
-  explicit TemporaryFile(std::string final_path);
+  /// Resolves the final path (replaceable_path), removes orphans (remove_orphaned_temporaries),
+  /// then creates the temporary file (mode 0666 less the umask). Throws FileWriteError when the
+  /// final path is refused or the file cannot be created.
+  explicit TemporaryFile(const std::string& final_path);
   ~TemporaryFile();
   TemporaryFile(const TemporaryFile&) = delete;
   TemporaryFile& operator=(const TemporaryFile&) = delete;
