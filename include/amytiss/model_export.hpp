@@ -1,5 +1,6 @@
 #pragma once
-// Export of the finite abstraction for independent checking (docs/export.md): PRISM's explicit
+// Export of the finite abstraction (guarantee: abstraction, the transition probabilities from the
+// cells' centre points) for independent checking (docs/export.md): PRISM's explicit
 // files (model.tra, model.sta, model.lab) or Storm's DRN (model.drn), with a README.md in the
 // folder saying how the files map to the specification.
 //
@@ -43,7 +44,9 @@ std::size_t export_transition_bound(const Abstraction& abstraction);
 
 /// Writes the model into `directory` (created if missing): every file under a temporary name, all
 /// renamed once all are on the disk, so a failure leaves no partial export and a previous one
-/// intact. Throws ExportTooLarge when export_transition_bound() exceeds `max_transitions`,
+/// intact. Throws ConfigError (key `guarantee`) for a configuration with guarantee: system (the
+/// export is the abstraction of the cells' centre points, whose values are not that guarantee's
+/// bounds), ExportTooLarge when export_transition_bound() exceeds `max_transitions`,
 /// std::runtime_error when a file cannot be written (naming the file and the system's reason).
 ExportSummary export_model(const Abstraction& abstraction, ExportFormat format, const std::string& directory,
                            std::size_t max_transitions);

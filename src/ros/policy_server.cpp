@@ -43,7 +43,7 @@ PolicyServerNode::PolicyServerNode(ros::NodeHandle public_handle, ros::NodeHandl
   marker_publisher_ = public_handle_.advertise<visualization_msgs::MarkerArray>("markers", 1, /*latch=*/true);
   std::string initial_file;
   private_handle_.param<std::string>("policy_file", initial_file, "");
-  if (!initial_file.empty()) load(LoadJob{initial_file, ""});
+  if (!initial_file.empty()) load(LoadJob{initial_file, "", "", ""});
   refresh_notices();
   ros::AdvertiseServiceOptions service_options = checked_get_input_options(
       "get_input", [this](amytiss::GetInput::Request& request, amytiss::GetInput::Response& response) {
@@ -72,34 +72,50 @@ PolicyServerNode::~PolicyServerNode() {
 void PolicyServerNode::load(const LoadJob& job) {
   try {
     amytiss::LoadedPolicy loaded = amytiss::read_policy_file(job.path);
-    const MarkedSets sets = marked_sets_from_yaml(loaded.config_yaml);
-    auto policy = std::make_shared<const amytiss::Policy>(std::move(loaded.policy));
-    std::atomic_store(&policy_, std::shared_ptr<const amytiss::Policy>(policy));
-    {
-      std::lock_guard<std::mutex> lock(monitor_mutex_);
-      served_ = ServedPolicy{sets.config_name, policy->config_hash, policy->run_id, job.path, wall_now()};
-      convergence_notice_ = convergence_notice(*policy);
-      follower_.loaded(policy_identity(policy->config_hash, policy->run_id));
-    }
-    refresh_notices();
-    visualization_msgs::MarkerArray markers = make_set_markers(policy->states, sets, frame_id_);
-    for (auto& marker : markers.markers) marker.header.stamp = ros::Time::now();
-    marker_publisher_.publish(markers);
-    ROS_INFO("serving policy '%s' (hash %s, run %s, horizon %u, %zu cells x %zu inputs) from %s",
-             sets.config_name.c_str(), policy->config_hash.c_str(), policy->run_id.c_str(), policy->horizon,
-             policy->states.size(), policy->inputs.size(), job.path.c_str());
+    const std::string mismatch = identity_mismatch(job, loaded.policy.config_hash, loaded.policy.run_id);
+    if (!mismatch.empty()) return refuse(job, mismatch);
+    serve(job, std::move(loaded));
   } catch (const std::exception& error) {
-    ROS_ERROR("cannot load policy %s: %s (still serving the previous policy, if any)", job.path.c_str(),
-              error.what());
-    bool ask = false;
-    {
-      std::lock_guard<std::mutex> lock(monitor_mutex_);
-      follower_.refused(job, error.what(), wall_now());
-      ask = follower_.take_synthesis_request(monitor_.last_status());
-    }
-    if (ask) request_synthesis();
-    refresh_notices();
+    refuse(job, error.what());
   }
+}
+
+void PolicyServerNode::serve(const LoadJob& job, amytiss::LoadedPolicy loaded) {
+  const MarkedSets sets = marked_sets_from_yaml(loaded.config_yaml);
+  auto policy = std::make_shared<const amytiss::Policy>(std::move(loaded.policy));
+  std::atomic_store(&policy_, std::shared_ptr<const amytiss::Policy>(policy));
+  {
+    std::lock_guard<std::mutex> lock(monitor_mutex_);
+    served_ = ServedPolicy{sets.config_name, policy->config_hash, policy->run_id, job.path, wall_now()};
+    convergence_notice_ = convergence_notice(*policy);
+    follower_.loaded(policy_identity(policy->config_hash, policy->run_id));
+  }
+  refresh_notices();
+  visualization_msgs::MarkerArray markers = make_set_markers(policy->states, sets, frame_id_);
+  for (auto& marker : markers.markers) marker.header.stamp = ros::Time::now();
+  marker_publisher_.publish(markers);
+  ROS_INFO("serving policy '%s' (hash %s, run %s, horizon %u, %zu cells x %zu inputs) from %s",
+           sets.config_name.c_str(), policy->config_hash.c_str(), policy->run_id.c_str(), policy->horizon,
+           policy->states.size(), policy->inputs.size(), job.path.c_str());
+}
+
+void PolicyServerNode::refuse(const LoadJob& job, const std::string& reason) {
+  bool ask = false, withdrawn = false;
+  {
+    std::lock_guard<std::mutex> lock(monitor_mutex_);
+    withdrawn = follower_.refused(job, reason, wall_now());
+    if (withdrawn) {
+      std::atomic_store(&policy_, std::shared_ptr<const amytiss::Policy>());
+      served_ = ServedPolicy{};
+      convergence_notice_.clear();
+    }
+    ask = follower_.take_synthesis_request(monitor_.last_status());
+  }
+  ROS_ERROR("cannot load policy %s: %s (%s)", job.path.c_str(), reason.c_str(),
+            withdrawn ? "no longer serving the policy read from ~policy_file: no status announces it"
+                      : "still serving the previous policy, if any");
+  if (ask) request_synthesis();
+  refresh_notices();
 }
 
 void PolicyServerNode::request_synthesis() {
@@ -193,6 +209,8 @@ void PolicyServerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("policy age (s)", have_policy ? now - served_.loaded_at_s : 0.0);
   status.add("policy convergence", convergence_notice_.empty() ? std::string("converged") : convergence_notice_);
   status.add("refused policy file", refusal);
+  status.add("announced config_hash", monitor_.last_status().config_hash);
+  status.add("announced run_id", monitor_.last_status().run_id);
   status.add("synthesizer", stopped.empty() ? std::string("running") : stopped);
   status.add("synthesis phase", monitor_.last_status().phase);
   status.add("synthesis percent", monitor_.last_status().percent);

@@ -9,18 +9,22 @@
 //   topic   command   (amytiss/InputCommand, out)  with the same stamp and time step
 //   topic   status    (amytiss/PolicyStatus, in)   loads policy_file when ready and
 //                                                       (config_hash, run_id) differs from the
-//                                                       policy served; its heartbeat tells
-//                                                       whether the synthesizer still runs
-//   action  synthesize (amytiss/Synthesize, client) a refused policy file (corrupt, missing) is
-//                                                  retried and the synthesizer asked to compute
-//                                                  it again (goal with force: true)
+//                                                       policy served, and refuses a file that
+//                                                       holds another policy; its heartbeat
+//                                                       tells whether the synthesizer still runs
+//   action  synthesize (amytiss/Synthesize, client) a refused policy file (corrupt, missing, not
+//                                                  the announced policy) is retried and the
+//                                                  synthesizer asked to compute it again (goal
+//                                                  with force: true)
 //   topic   markers   (visualization_msgs/MarkerArray, latched) grid bounds, target, avoid, safe
 //   topic   /diagnostics (diagnostic_updater): policy loaded, its name, hash, run id and age,
-//                                              refused file, synthesizer alive or not, synthesis
+//                                              refused file, the announced hash and run id,
+//                                              synthesizer alive or not, synthesis
 //                                              state, device, get_input calls answered on the
 //                                              network thread and on a spinner thread
 // Private parameters: ~policy_file (string, optional: a policy to serve from the start, before
-// any status arrives), ~frame_id (string, default "map") for the markers,
+// any status arrives; once a status announces another policy and its file is refused, it is no
+// longer served), ~frame_id (string, default "map") for the markers,
 // ~synthesizer_timeout_s (double, default 3): no status for this long means the synthesizer
 // stopped (it sends one every second), ~retry_period_s (double, default 5): a refused file that
 // is still announced is read again after this long.
@@ -39,6 +43,7 @@
 #include <ros/ros.h>
 
 #include "amytiss/policy.hpp"
+#include "amytiss/policy_file.hpp"
 #include "immediate_callback_queue.hpp"
 #include "policy_follower.hpp"
 #include "synthesizer_monitor.hpp"
@@ -59,9 +64,12 @@ class PolicyServerNode {
   };
 
   /// Loads a policy file and swaps it in atomically (requests in flight finish on the old one).
-  /// On failure (missing, corrupt: a checksum does not match) the old policy stays, the refusal
-  /// is recorded in follower_, and the synthesizer is asked to compute the policy again.
+  /// On failure (missing, corrupt: a checksum does not match; another policy than the status
+  /// announced) the refusal is recorded in follower_, the old policy stays unless no status ever
+  /// announced it (PolicyFollower::refused), and the synthesizer is asked to compute it again.
   void load(const LoadJob& job);
+  void serve(const LoadJob& job, amytiss::LoadedPolicy loaded);
+  void refuse(const LoadJob& job, const std::string& reason);
   void request_synthesis();
   bool on_get_input(amytiss::GetInput::Request& request, amytiss::GetInput::Response& response);
   void on_state(const amytiss::StateStamped::ConstPtr& state);

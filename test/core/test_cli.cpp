@@ -298,6 +298,11 @@ TEST_F(CliTest, ExportWritesTheModelOrRefusesItAboveTheLimit) {
   result = synth("--config " + quote(kTinyConfig) + " --export prism out --export-max-transitions lots");
   EXPECT_EQ(2, result.exit_code);
   EXPECT_CONTAINS(result.err, "--export-max-transitions: got 'lots'");
+  // The export is the centre-point abstraction: not what guarantee: system's bounds are about.
+  result = synth("--config " + quote(kTinyConfig) + " --guarantee system --export drn system");
+  EXPECT_EQ(2, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.err, "guarantee: got system");
+  EXPECT_FALSE(fs::exists(path("system")));
 }
 
 TEST_F(CliTest, UnwritableOutputExitsOne) {

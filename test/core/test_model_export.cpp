@@ -20,6 +20,7 @@
 #include "amytiss/abstraction.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
 #include "amytiss/model_export.hpp"
 
 #include "child_process.hpp"
@@ -245,6 +246,41 @@ TEST(ModelExport, RefusesModelsAboveTheLimit) {
   EXPECT_THROW(export_model(a, ExportFormat::Prism, folder.string(), bound - 1), ExportTooLarge);
   EXPECT_FALSE(fs::exists(folder));
   EXPECT_NO_THROW(export_model(a, ExportFormat::Prism, folder.string(), bound));
+  fs::remove_all(folder);
+}
+
+// The export writes the abstraction built from the cells' centre points: under guarantee: system
+// its values would pass for continuous-system bounds they are not, so it is refused, and the
+// README says which value the files give.
+TEST(ModelExport, RefusesGuaranteeSystemNamingTheKey) {
+  const Abstraction a =
+      Abstraction::from_config(config_from_yaml(YAML::Load(std::string(kReachAvoidYaml) + "guarantee: system\n")));
+  const fs::path folder = scratch("system");
+  try {
+    export_model(a, ExportFormat::Drn, folder.string(), kNoTransitionLimit);
+    ADD_FAILURE() << "guarantee: system was exported";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ("guarantee", error.key());
+    const std::string message = error.what();
+    EXPECT_NE(std::string::npos, message.find("got system")) << message;
+    EXPECT_NE(std::string::npos, message.find("example: guarantee: abstraction")) << message;
+  }
+  EXPECT_FALSE(fs::exists(folder)) << "a refused export writes nothing";
+  fs::remove_all(folder);
+}
+
+TEST(ModelExport, ReadmeSaysTheValueIsTheCentrePointAbstractions) {
+  const Abstraction a = Abstraction::from_config(config_from_yaml(YAML::Load(kReachAvoidYaml)));
+  const fs::path folder = scratch("readme");
+  export_model(a, ExportFormat::Prism, folder.string(), kNoTransitionLimit);
+  std::ifstream file(folder / "README.md");
+  const std::string readme((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  for (const char* part : {"The bounded-horizon value V_0 of this finite MDP from each cell is",
+                           "Pmax=? [ !(\"avoid\" | \"sink\") U<=4 \"target\" ]",
+                           "the value amytiss computes with `guarantee: abstraction`",
+                           "from each cell's centre point", "not a bound of the continuous system's probability"})
+    EXPECT_NE(std::string::npos, readme.find(part)) << part << "\n" << readme;
+  EXPECT_EQ(std::string::npos, readme.find("value V_0 of amytiss")) << readme;
   fs::remove_all(folder);
 }
 

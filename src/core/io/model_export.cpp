@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
 #include "io/temporary_file.hpp"
 
@@ -262,6 +263,11 @@ std::size_t export_transition_bound(const Abstraction& a) {
 
 ExportSummary export_model(const Abstraction& a, ExportFormat format, const std::string& directory,
                            std::size_t max_transitions) {
+  if (a.config.guarantee == Guarantee::System)
+    throw ConfigError("guarantee",
+                      "got system, but the export writes only the finite abstraction built from the cells' centre "
+                      "points, whose values are not the continuous-system bounds that guarantee: system computes; "
+                      "expected abstraction (example: guarantee: abstraction, or --guarantee abstraction)");
   const std::size_t bound = export_transition_bound(a);
   if (bound > max_transitions)
     throw ExportTooLarge("the model has up to " + std::to_string(bound) + " transitions, more than the limit " +
@@ -318,18 +324,24 @@ std::string readme_text(const Abstraction& a, const ExportLayout& layout, Export
   const std::string bound =
       a.unbounded ? std::string() : "<=" + std::to_string(layout.adversary ? 2 * horizon : horizon);
   const std::string which = a.unbounded ? "unbounded value" : "bounded-horizon value V_0";
+  const std::string property =
+      a.spec == SpecType::Safety ? "Pmax=? [ G" + bound + " !(\"unsafe\" | \"sink\") ]"
+                                 : "Pmax=? [ !(\"avoid\" | \"sink\") U" + bound + " \"target\" ]";
   if (a.spec == SpecType::Safety)
-    s << "`unsafe`: the cells whose point lies in no box of the safe set. The " << which << " of amytiss is\n\n"
-      << "    Pmax=? [ G" << bound << " !(\"unsafe\" | \"sink\") ]\n\n";
+    s << "`unsafe`: the cells whose point lies in no box of the safe set. ";
   else
-    s << "`target`: the cells whose point lies in a target box; `avoid`: those in an avoid box. The " << which
-      << " of amytiss is\n\n"
-      << "    Pmax=? [ !(\"avoid\" | \"sink\") U" << bound << " \"target\" ]\n\n";
-  s << "from each cell";
-  if (!a.unbounded) s << " (horizon T = " << horizon << ", " << steps << " model steps)";
-  s << (layout.adversary ? ", with the adversary states minimizing. " : ". ")
-    << (a.unbounded ? "" : "Drop the bound (`G`, `U` without `<=`) for the unbounded value.")
-    << "\n\n"
+    s << "`target`: the cells whose point lies in a target box; `avoid`: those in an avoid box. ";
+  s << "The " << which << " of this finite MDP from each cell is\n\n    " << property << "\n\n";
+  const std::string minimizing = layout.adversary ? ", the adversary states minimizing" : "";
+  if (!a.unbounded)
+    s << "(horizon T = " << horizon << ", " << steps << " model steps" << minimizing
+      << "; drop the bound, `G` or `U` without `<=`, for the unbounded value). ";
+  else if (layout.adversary)
+    s << "(" << minimizing.substr(2) << "). ";
+  s << "It is the value amytiss computes with `guarantee: abstraction`: the value of the abstraction whose "
+    << "transition probabilities are those from each cell's centre point (`lb + k*eta`), not a bound of the "
+    << "continuous system's probability from the other points of the cell (`guarantee: system` computes those "
+    << "bounds over an interval MDP, which the export does not write).\n\n"
     << "## Configuration\n\n```yaml\n" << to_yaml(a.config) << "```\n";
   return s.str();
 }
