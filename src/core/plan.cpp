@@ -101,6 +101,9 @@ double planned_multiply_adds_per_step(const Abstraction& a) {
 SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& options, EngineScope scope) {
   SynthesisPlan plan;
   plan.multiply_adds_per_step = planned_multiply_adds_per_step(a);
+  if (a.config.spec.obstacles)
+    note(plan, "footprint: " + footprint_work_text(a.config.states, a.config.spec) + " to find the cells it may touch, " +
+                   "at most " + format_number(kMaxFootprintBoxTests) + " accepted");
   const bool any = scope == EngineScope::Any;
   if (a.config.guarantee == Guarantee::System) {
     plan_bounds(options, scope, plan);

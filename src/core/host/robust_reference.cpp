@@ -124,7 +124,8 @@ RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
   return out;
 }
 
-std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& spec, Bound bound) {
+std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& spec, Bound bound,
+                                        const SetupPoll& poll) {
   const std::size_t dims = states.dims();
   std::vector<std::size_t> multi(dims);
   std::vector<double> cell_lo(dims), cell_hi(dims), slack(dims);
@@ -139,7 +140,8 @@ std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& sp
   const bool lower = bound == Bound::Lower;
   // The lower bound avoids every cell whose body may touch an obstacle at some pose; the upper
   // bound would need "touches at every pose" and, soundly, avoids no cell for obstacles.
-  const std::vector<bool> touched = lower ? obstacle_cells(states, spec) : std::vector<bool>(states.size(), false);
+  const std::vector<bool> touched =
+      lower ? obstacle_cells(states, spec, poll) : std::vector<bool>(states.size(), false);
   std::vector<CellRole> roles(states.size(), CellRole::Free);
   for (std::size_t cell = 0; cell < states.size(); ++cell) {
     states.multi_index(cell, multi.data());

@@ -17,8 +17,9 @@ Policy run_system_bounds(const Abstraction& a, AmbiguitySet set, StepReporter& r
                                                        (threads == 1 ? "" : "s") + ")");
   reporter.reached(Phase::Setup);
   const auto construction_start = SteadyClock::now();
-  std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
-  std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
+  const SetupPoll poll = [&reporter] { reporter.reached(Phase::Setup); };
+  std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower, poll);
+  std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper, poll);
   const std::string targets = lower_targets_text(lower_roles, a.config.spec.type);
   const bool no_target = std::none_of(lower_roles.begin(), lower_roles.end(),
                                       [](CellRole role) { return role == CellRole::FixedOne; });
