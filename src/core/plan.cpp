@@ -136,9 +136,9 @@ std::vector<std::string> describe_plan(const Abstraction& a, SynthesisPlan& plan
     lines.push_back("transitions: " + storage.transitions);
   }
   if (plan.engine == EngineKind::Bounds) {
-    const std::string targets =
-        lower_targets_text(robust_cell_roles(a.states, a.config.spec, Bound::Lower), a.config.spec.type);
-    if (!targets.empty()) lines.push_back("continuous-system bounds: " + targets);
+    const std::string kept =
+        lower_roles_text(a.states, a.config.spec, robust_cell_roles(a.states, a.config.spec, Bound::Lower)).text;
+    if (!kept.empty()) lines.push_back("continuous-system bounds: " + kept);
   }
   if (plan.engine != EngineKind::Team) return lines;
   Team& team = *plan.team->team;
