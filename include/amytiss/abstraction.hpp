@@ -14,9 +14,11 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
+#include "amytiss/footprint.hpp"
 #include "amytiss/grid.hpp"
 #include "amytiss/model.hpp"
 #include "amytiss/noise.hpp"
+#include "amytiss/synthesis_types.hpp"
 
 namespace amytiss {
 
@@ -37,12 +39,15 @@ struct Abstraction {
 
   /// Builds from a configuration that passed Config::validate() (config_from_yaml and
   /// load_config_file validate; this does not judge it again). Throws std::logic_error when an
-  /// invariant validate() guarantees does not hold (a bug of the caller).
-  static Abstraction from_config(const Config& config);
+  /// invariant validate() guarantees does not hold (a bug of the caller). The footprint's test of
+  /// the cells reports Phase::Setup to `progress` about every kPollSeconds; when it returns false,
+  /// throws Cancelled.
+  static Abstraction from_config(const Config& config, const ProgressCallback& progress = {});
   /// Builds from a validated configuration and given dynamics (tests: lambda dynamics) without
   /// make_dynamics(). Throws std::logic_error when what it uses (grids, noise, sets, horizon, the
-  /// dynamics' dimensions) breaks an invariant of a validated configuration.
-  static Abstraction from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics);
+  /// dynamics' dimensions) breaks an invariant of a validated configuration. `progress` as above.
+  static Abstraction from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics,
+                                const ProgressCallback& progress = {});
 
   /// V_{T_d} of a cell with the given role.
   double terminal_value(CellRole role) const;
@@ -56,7 +61,7 @@ struct Abstraction {
 /// FixedOne. Reach-avoid: avoid -> FixedZero, target -> FixedOne; a cell in both (a configuration
 /// error that validate() rejects) is FixedZero: avoid is applied first and wins.
 /// Throws std::logic_error for a missing target, a set without boxes or a box of the wrong
-/// dimension (validate() refuses them).
-std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec);
+/// dimension (validate() refuses them). `poll`: as obstacle_cells() calls it.
+std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec, const SetupPoll& poll = {});
 
 }  // namespace amytiss

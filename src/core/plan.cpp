@@ -106,6 +106,9 @@ double planned_multiply_adds_per_step(const Abstraction& a) {
 SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& options, EngineScope scope) {
   SynthesisPlan plan;
   plan.multiply_adds_per_step = planned_multiply_adds_per_step(a);
+  if (a.config.spec.obstacles)
+    note(plan, "footprint: " + footprint_work_text(a.config.states, a.config.spec) + " to find the cells it may touch, " +
+                   "at most " + format_number(kMaxFootprintBoxTests) + " accepted");
   const bool any = scope == EngineScope::Any;
   if (a.config.guarantee == Guarantee::System) {
     plan_bounds(options, scope, plan);
@@ -138,9 +141,9 @@ std::vector<std::string> describe_plan(const Abstraction& a, SynthesisPlan& plan
     lines.push_back("transitions: " + storage.transitions);
   }
   if (plan.engine == EngineKind::Bounds) {
-    const std::string targets =
-        lower_targets_text(robust_cell_roles(a.states, a.config.spec, Bound::Lower), a.config.spec.type);
-    if (!targets.empty()) lines.push_back("continuous-system bounds: " + targets);
+    const std::string kept =
+        lower_roles_text(a.states, a.config.spec, robust_cell_roles(a.states, a.config.spec, Bound::Lower)).text;
+    if (!kept.empty()) lines.push_back("continuous-system bounds: " + kept);
   }
   if (plan.engine != EngineKind::Team) return lines;
   Team& team = *plan.team->team;

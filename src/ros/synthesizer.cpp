@@ -198,7 +198,6 @@ void SynthesizerNode::synthesize_and_write(const amytiss::Config& config, const 
     status.message = "synthesizing '" + config.name + "' on " + device;
   });
   const auto started = std::chrono::steady_clock::now();
-  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config);
   amytiss::SynthesisOptions options;
   options.compute = config.compute;
   options.progress = [&](const amytiss::Progress& progress) {
@@ -215,6 +214,8 @@ void SynthesizerNode::synthesize_and_write(const amytiss::Config& config, const 
     on_progress(progress);
     return !cancelled();
   };
+  // The abstraction's set-up (the footprint's test of the cells) reports progress and can be cancelled too.
+  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config, options.progress);
   amytiss::SynthesisReport report;
   const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
   for (const auto& note : report.notes) {

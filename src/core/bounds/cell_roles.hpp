@@ -23,8 +23,10 @@ using MeanBox = std::function<void(std::size_t cell, std::size_t input, std::siz
 /// as it meets the avoid set (leaves the safe set). Upper: target as soon as it meets the target,
 /// avoid only inside the avoid set (unsafe only when it misses the safe set). Avoid wins.
 /// Sets that are unions of boxes: "meets" is meeting one of the boxes, "inside" is lying inside
-/// their union (exactly: a cell covered by several boxes together is inside).
+/// their union (exactly, by box_covered(): a cell covered by several boxes together is inside);
+/// ConfigError naming the set for a union too intricate to decide. `poll`: as obstacle_cells().
 constexpr double kFaceTolerance = 1e-9;
-std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& spec, Bound bound);
+std::vector<CellRole> robust_cell_roles(const Grid& states, const SpecConfig& spec, Bound bound,
+                                        const SetupPoll& poll = {});
 
 }  // namespace amytiss::detail

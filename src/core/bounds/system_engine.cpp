@@ -18,14 +18,13 @@ Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial,
                              : "host (" + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") + ")");
   reporter.reached(Phase::Setup);
   const auto construction_start = SteadyClock::now();
-  std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower);
-  std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper);
-  const std::string targets = lower_targets_text(lower_roles, a.config.spec.type);
-  const bool no_target = std::none_of(lower_roles.begin(), lower_roles.end(),
-                                      [](CellRole role) { return role == CellRole::FixedOne; });
-  if (!targets.empty())
+  const SetupPoll poll = [&reporter] { reporter.reached(Phase::Setup); };
+  std::vector<CellRole> lower_roles = robust_cell_roles(a.states, a.config.spec, Bound::Lower, poll);
+  std::vector<CellRole> upper_roles = robust_cell_roles(a.states, a.config.spec, Bound::Upper, poll);
+  const RolesText kept = lower_roles_text(a.states, a.config.spec, lower_roles);
+  if (!kept.text.empty())
     reporter.report().notes.push_back(
-        {no_target ? NoteSeverity::Warning : NoteSeverity::Info, NoteKind::Transitions, targets});
+        {kept.warning ? NoteSeverity::Warning : NoteSeverity::Info, NoteKind::Transitions, kept.text});
   std::vector<bool> needed(a.states.size());
   for (std::size_t x = 0; x < needed.size(); ++x)
     needed[x] = lower_roles[x] == CellRole::Free || upper_roles[x] == CellRole::Free;
@@ -61,14 +60,48 @@ Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial,
   return policy;
 }
 
-std::string lower_targets_text(const std::vector<CellRole>& lower_roles, SpecType spec) {
-  if (spec == SpecType::Safety) return "";
-  const auto inside = std::size_t(std::count(lower_roles.begin(), lower_roles.end(), CellRole::FixedOne));
-  std::string text = std::to_string(inside) + " of " + std::to_string(lower_roles.size()) +
-                     " cells lie wholly inside the target (the lower bound's target cells)";
+namespace {
+
+std::size_t count_role(const std::vector<CellRole>& roles, CellRole role) {
+  return std::size_t(std::count(roles.begin(), roles.end(), role));
+}
+
+// Why the lower bound keeps no cell: none inside the set itself, or every one inside it avoided
+// (by spec.avoid, else by the footprint). Only for that case: it redoes the roles without them.
+std::string no_cell_reason(const Grid& states, const SpecConfig& spec, CellRole kept) {
+  const bool safety = spec.type == SpecType::Safety;
+  SpecConfig bare = spec;
+  bare.avoid.reset();
+  bare.obstacles.reset();
+  bare.footprint.reset();
+  const std::size_t inside = count_role(robust_cell_roles(states, bare, Bound::Lower), kept);
   if (inside == 0)
-    text += ": the lower bound is 0 everywhere; draw the target on the cells' faces, lb + (k +- 1/2) eta";
-  return text;
+    return std::string("; draw the ") + (safety ? "safe set" : "target") + " on the cells' faces, lb + (k +- 1/2) eta";
+  const std::string cells = std::to_string(inside) + " cell" + (inside == 1 ? "" : "s");
+  if (!safety && spec.avoid) {
+    bare.avoid = spec.avoid;
+    if (count_role(robust_cell_roles(states, bare, Bound::Lower), kept) == 0)
+      return "; the " + cells + " wholly inside the target all meet spec.avoid";
+  }
+  return "; the " + cells + " wholly inside the " + (safety ? "safe set" : "target") +
+         " are all avoided: the footprint may touch an obstacle (spec.obstacles) at some pose of each";
+}
+
+}  // namespace
+
+RolesText lower_roles_text(const Grid& states, const SpecConfig& spec, const std::vector<CellRole>& lower_roles) {
+  const bool safety = spec.type == SpecType::Safety;
+  const CellRole kept = safety ? CellRole::Free : CellRole::FixedOne;
+  const std::size_t count = count_role(lower_roles, kept);
+  if (safety && count > 0) return {};
+  RolesText out;
+  out.text = std::to_string(count) + " of " + std::to_string(lower_roles.size()) +
+             (safety ? " cells lie wholly inside the safe set (the lower bound's safe cells)"
+                     : " cells lie wholly inside the target (the lower bound's target cells)");
+  if (count > 0) return out;
+  out.warning = true;
+  out.text += ": the lower bound is 0 everywhere" + no_cell_reason(states, spec, kept);
+  return out;
 }
 
 }  // namespace amytiss::detail

@@ -17,9 +17,15 @@ namespace amytiss::detail {
 /// gives the system map (ImageEnclosure) and the sets.
 Policy run_system_bounds(const Abstraction& abstraction, BoundsMethod method, bool serial, StepReporter& reporter);
 
-/// Reach specifications: "891 of 60125 cells lie wholly inside the target (the lower bound's target
-/// cells)"; with none, also that the lower bound is then 0 everywhere and how to draw the target.
-/// Empty for safety. `lower_roles`: robust_cell_roles() of the lower bound.
-std::string lower_targets_text(const std::vector<CellRole>& lower_roles, SpecType spec);
+/// What the lower bound's roles (`lower_roles`: robust_cell_roles()) leave it. Reach
+/// specifications: "891 of 60125 cells lie wholly inside the target (the lower bound's target
+/// cells)". Safety: empty while some cell is kept. With no cell (the lower bound 0 everywhere, a
+/// warning), why: no cell lies wholly inside the set (how to draw it), or every cell inside it is
+/// avoided (it meets spec.avoid, or the footprint may touch an obstacle).
+struct RolesText {
+  std::string text;
+  bool warning = false;
+};
+RolesText lower_roles_text(const Grid& states, const SpecConfig& spec, const std::vector<CellRole>& lower_roles);
 
 }  // namespace amytiss::detail

@@ -42,8 +42,8 @@ inline std::string format_list(const std::vector<double>& values) {
 void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::string, double>& constants);
 
 /// Config::validate()'s checks of `spec.obstacles` and `spec.footprint` (obstacles_section.cpp);
-/// `n`: the state dimension.
-void check_obstacles(const SpecConfig& spec, std::size_t n);
+/// `states`: the state grid (its dimension, and the cells the footprint is tested on).
+void check_obstacles(const SpecConfig& spec, const GridSpec& states);
 
 /// Throws ConfigError naming key[i] for the first value that is NaN or infinite.
 inline void check_finite_list(const std::vector<double>& values, const std::string& key, const std::string& example) {

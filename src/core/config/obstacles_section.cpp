@@ -1,10 +1,12 @@
 // Config::validate()'s checks of `spec.obstacles` and `spec.footprint` (docs/configuration.md,
 // "Obstacles and the car's footprint").
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/footprint.hpp"
 #include "config/messages.hpp"
 
 namespace amytiss::detail {
@@ -54,9 +56,26 @@ void check_obstacle_box(const Box& box, const std::string& key) {
            "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(box.lb[i]), kObstacleExample);
 }
 
+// The body's test over every cell must end in reasonable time: refused past its budget, naming the
+// dimension of the body that sets the pieces' length (the width, unless the cells are coarser).
+void check_footprint_work(const SpecConfig& spec, const GridSpec& states) {
+  const double tests = footprint_box_tests(states, spec);
+  if (tests <= kMaxFootprintBoxTests) return;
+  const Footprint& footprint = *spec.footprint;
+  const bool by_width = 0.5 * footprint.width >= grid_body_cut(states, spec).min_side;
+  const std::string estimate = footprint_work_text(states, spec);
+  fail(by_width ? "spec.footprint.width" : "spec.footprint.length",
+       format_number(by_width ? footprint.width : footprint.length) + ": its test of the cells needs " + estimate,
+       "a body tested in at most " + format_number(kMaxFootprintBoxTests) +
+           " box tests (pieces of side max(width/2, half the finer cell side in x and y) along its length; a " +
+           (by_width ? "wider" : "shorter") + " body, fewer cells or fewer obstacles)",
+       kFootprintExample);
+}
+
 }  // namespace
 
-void check_obstacles(const SpecConfig& spec, std::size_t n) {
+void check_obstacles(const SpecConfig& spec, const GridSpec& states) {
+  const std::size_t n = states.lb.size();
   if (!spec.obstacles && !spec.footprint) return;
   if (!spec.footprint)
     throw ConfigError("spec.footprint",
@@ -73,6 +92,7 @@ void check_obstacles(const SpecConfig& spec, std::size_t n) {
   for (std::size_t i = 0; i < obstacles.boxes.size(); ++i)
     check_obstacle_box(obstacles.boxes[i],
                        obstacles.boxes.size() == 1 ? "spec.obstacles" : indexed("spec.obstacles", i));
+  check_footprint_work(spec, states);
 }
 
 }  // namespace amytiss::detail

@@ -247,7 +247,7 @@ void check_spec(const SpecConfig& spec, const GridSpec& states) {
       }
       break;
   }
-  check_obstacles(spec, states.lb.size());
+  check_obstacles(spec, states);
 }
 
 void check_compute(const ComputeConfig& compute) {

@@ -1,5 +1,6 @@
 #include "amytiss/abstraction.hpp"
 
+#include <chrono>
 #include <stdexcept>
 #include <string>
 
@@ -22,11 +23,11 @@ void require_region(const Region& region, std::size_t dims) {
 
 }  // namespace
 
-std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
+std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec, const SetupPoll& poll) {
   std::vector<CellRole> roles(states.size(), CellRole::Free);
   const std::size_t dims = states.dims();
   // The footprint test judges the whole cell, not only its point: no pose of the cell may touch.
-  const std::vector<bool> touched = obstacle_cells(states, spec);
+  const std::vector<bool> touched = obstacle_cells(states, spec, poll);
   switch (spec.type) {
     case SpecType::Safety:
       if (spec.safe) require_region(*spec.safe, dims);
@@ -52,12 +53,13 @@ std::vector<CellRole> cell_roles(const Grid& states, const SpecConfig& spec) {
   return roles;
 }
 
-Abstraction Abstraction::from_config(const Config& config) {
+Abstraction Abstraction::from_config(const Config& config, const ProgressCallback& progress) {
   std::shared_ptr<const Dynamics> dynamics = make_dynamics(config);
-  return from_parts(config, std::move(dynamics));
+  return from_parts(config, std::move(dynamics), progress);
 }
 
-Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics) {
+Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const Dynamics> dynamics,
+                                    const ProgressCallback& progress) {
   Abstraction abstraction;
   abstraction.config = config;
   abstraction.states = Grid(config.states);
@@ -76,7 +78,13 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
   abstraction.tolerance = config.spec.tolerance_or_default();
   // An unbounded specification's stationary policy is laid out like one step of a finite one.
   abstraction.horizon = config.spec.unbounded ? 1 : config.spec.horizon;
-  abstraction.roles = cell_roles(abstraction.states, config.spec);
+  const auto setup_start = std::chrono::steady_clock::now();
+  const unsigned total = abstraction.unbounded ? 0 : abstraction.horizon;
+  const SetupPoll poll = [&] {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
+    if (progress && !progress({Phase::Setup, 0, total, "", elapsed, -1})) throw Cancelled();
+  };
+  abstraction.roles = cell_roles(abstraction.states, config.spec, poll);
   return abstraction;
 }
 
