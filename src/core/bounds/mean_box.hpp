@@ -1,5 +1,5 @@
 #pragma once
-// The robust reference's mean boxes (bounds/cell_roles.hpp) from image enclosures of the
+// The bounds' mean boxes (MeanBox, bounds/cell_roles.hpp) from image enclosures of the
 // system map (amytiss/enclosure.hpp, docs/semantics.md "Image enclosures").
 #include "amytiss/enclosure.hpp"
 #include "amytiss/grid.hpp"
