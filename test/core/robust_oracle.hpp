@@ -13,10 +13,13 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
+#include "amytiss/enclosure.hpp"
 #include "bounds/cell_roles.hpp"
+#include "bounds/mean_box.hpp"
 #include "bounds/mass_bounds.hpp"
 #include "bounds/omax/robust_expectation.hpp"
 
@@ -139,6 +142,24 @@ inline RobustValues robust_values(const RobustProblem& p, AmbiguitySet set) {
     }
   }
   return out;
+}
+
+/// The oracle's bounds of an abstraction's configuration: its cell roles of each bound, and its
+/// mean boxes from the image enclosures of its dynamics unless `mean_box` gives others.
+inline RobustValues robust_values_of(const Abstraction& a, AmbiguitySet set, std::vector<std::size_t> order = {},
+                                     MeanBox mean_box = nullptr) {
+  const ImageEnclosure enclosure(a.config);
+  const RobustProblem problem{a.states,
+                              a.inputs,
+                              a.disturbances,
+                              *a.noise,
+                              mean_box ? mean_box : enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances),
+                              a.spec,
+                              a.horizon,
+                              robust_cell_roles(a.states, a.config.spec, Bound::Lower),
+                              robust_cell_roles(a.states, a.config.spec, Bound::Upper),
+                              std::move(order)};
+  return robust_values(problem, set);
 }
 
 }  // namespace amytiss::detail

@@ -54,7 +54,6 @@ std::string small_3d_yaml() {
 // the variable elimination (a sound bound of its own, docs/semantics.md), in product_expectation()'s
 // order for the others.
 RobustValues oracle(const Abstraction& a, BoundsMethod method) {
-  const ImageEnclosure enclosure(a.config);
   std::vector<std::size_t> order;
   if (method == BoundsMethod::Elimination) {
     const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, nullptr);
@@ -62,17 +61,8 @@ RobustValues oracle(const Abstraction& a, BoundsMethod method) {
     if (plan)
       for (const FactoredStage& stage : plan->stages) order.push_back(stage.dimension);
   }
-  const RobustProblem problem{a.states,
-                              a.inputs,
-                              a.disturbances,
-                              *a.noise,
-                              enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances),
-                              a.spec,
-                              a.horizon,
-                              robust_cell_roles(a.states, a.config.spec, Bound::Lower),
-                              robust_cell_roles(a.states, a.config.spec, Bound::Upper),
-                              order};
-  return robust_values(problem, method == BoundsMethod::Joint ? AmbiguitySet::Joint : AmbiguitySet::Product);
+  return robust_values_of(a, method == BoundsMethod::Joint ? AmbiguitySet::Joint : AmbiguitySet::Product,
+                          std::move(order));
 }
 
 template <BoundsMethod M>

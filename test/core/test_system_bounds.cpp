@@ -61,13 +61,7 @@ constexpr double kProductGain = 0.01;
 // Shared pieces
 
 RobustValues system_bounds(const Abstraction& a, AmbiguitySet set, MeanBox mean_box = nullptr) {
-  const ImageEnclosure enclosure(a.config);
-  RobustProblem problem{a.states, a.inputs, a.disturbances, *a.noise,
-                        mean_box ? mean_box : enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances),
-                        a.spec, a.horizon,
-                        robust_cell_roles(a.states, a.config.spec, Bound::Lower),
-                        robust_cell_roles(a.states, a.config.spec, Bound::Upper)};
-  return robust_values(problem, set);
+  return robust_values_of(a, set, {}, std::move(mean_box));
 }
 
 // The abstraction's controller in the robust reference's layout, [k * cells + cell].

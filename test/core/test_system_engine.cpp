@@ -45,20 +45,6 @@ std::string small_3d_yaml(unsigned horizon, bool truncated = true) {
          ", target: {lb: [1, -2, -1], ub: [2, 2, 1]}, avoid: {lb: [-2, -2, -1], ub: [-1.5, 2, 1]}}\n";
 }
 
-RobustValues oracle(const Abstraction& a, AmbiguitySet set) {
-  const ImageEnclosure enclosure(a.config);
-  const RobustProblem problem{a.states,
-                              a.inputs,
-                              a.disturbances,
-                              *a.noise,
-                              enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances),
-                              a.spec,
-                              a.horizon,
-                              robust_cell_roles(a.states, a.config.spec, Bound::Lower),
-                              robust_cell_roles(a.states, a.config.spec, Bound::Upper)};
-  return robust_values(problem, set);
-}
-
 SynthesisOptions options_for(DeviceKind device) {
   SynthesisOptions options;
   options.compute.device = device;
@@ -71,7 +57,7 @@ void expect_matches_oracle(const std::string& yaml, DeviceKind device, Ambiguity
   SynthesisOptions options = options_for(device);
   options.compute.bounds_method = method;
   const Policy policy = synthesize(a, options, nullptr);
-  const RobustValues expected = oracle(a, set);
+  const RobustValues expected = robust_values_of(a, set);
   ASSERT_EQ(policy.guarantee, Guarantee::System);
   ASSERT_EQ(policy.upper_values.size(), policy.values.size());
   const std::size_t cells = a.states.size();
