@@ -3,12 +3,12 @@
 #include <math.h>
 
 #include <algorithm>
-#include <stdexcept>
 
 #include "amytiss/errors.hpp"
 #include "amytiss/expression.hpp"
 #include "amytiss/format.hpp"
 #include "common/embedded_sources.hpp"
+#include "common/require.hpp"
 
 namespace amytiss {
 namespace builtin {
@@ -212,9 +212,7 @@ std::vector<std::size_t> merged(std::vector<std::size_t> a, const std::vector<st
 }
 
 // The configuration passed Config::validate(); a violation is a bug of the caller.
-void require(bool invariant, const std::string& what) {
-  if (!invariant) throw std::logic_error("make_dynamics: expected a validated configuration: " + what);
-}
+constexpr detail::Require require{"make_dynamics: expected a validated configuration: "};
 
 }  // namespace
 
