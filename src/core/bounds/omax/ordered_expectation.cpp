@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "bounds/row_bounds.hpp"
+#include "common/parallel_for.hpp"
 #include "common/require.hpp"
 
 namespace amytiss::detail {

@@ -5,6 +5,7 @@
 
 #include "amytiss/format.hpp"
 #include "amytiss/stopwatch.hpp"
+#include "common/parallel_for.hpp"
 #include "common/require.hpp"
 
 namespace amytiss::detail {
