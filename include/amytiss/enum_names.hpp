@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "amytiss/config.hpp"
-#include "amytiss/engine.hpp"
+#include "amytiss/synthesis_types.hpp"
 
 namespace amytiss {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Concrete noise for closed-loop simulation, drawn from the same noise description the
-// abstraction computes its probabilities with (docs/semantics.md, "Noise"): every law the
-// configuration accepts, additive or multiplicative.
+// abstraction computes its probabilities with (docs/semantics.md, "Drawing concrete noise"): every
+// law the configuration accepts, additive or multiplicative.
 //   normal:       Z = L z, z standard normal, L the Cholesky factor of the covariance (diagonal:
 //                 the standard deviations);
 //   uniform:      Z_i = h_i * U(-1, 1);

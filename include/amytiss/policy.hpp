@@ -7,6 +7,7 @@
 
 #include "amytiss/abstraction.hpp"
 #include "amytiss/grid.hpp"
+#include "amytiss/run_id.hpp"  // new_run_id() for Policy::run_id
 
 namespace amytiss {
 
@@ -89,8 +90,5 @@ struct BoundsSummary {
   std::size_t free_cells = 0;
 };
 BoundsSummary summarize_bounds(const Policy& policy);
-
-/// A fresh random run id (16 lowercase hex digits) from std::random_device.
-std::string new_run_id();
 
 }  // namespace amytiss

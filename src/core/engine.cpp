@@ -3,6 +3,7 @@
 #include "amytiss/engine.hpp"
 
 #include "amytiss/format.hpp"
+#include "amytiss/run_id.hpp"
 #include "execute.hpp"
 #include "serial/reference_engine.hpp"
 #include "opencl/device.hpp"

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -57,31 +58,109 @@ int layer_of(const std::string& folder) {
   return -1;
 }
 
+// The layer of each public header: that of the folder that implements it. Headers of types and
+// interfaces only (errors, stopwatch, version, scale_out's Communicator) and those whose code is
+// common's (the enum names of config.hpp and synthesis_types.hpp) are common's. config.hpp also
+// declares config/'s reading and checks, which the layers below config/ do not call.
+const std::map<std::string, std::string>& public_header_folders() {
+  static const std::map<std::string, std::string> folders = {
+      {"abstraction.hpp", "model"}, {"apriori_error.hpp", "model"},  {"config.hpp", "common"},
+      {"enclosure.hpp", "model"},   {"engine.hpp", ""},               {"enum_names.hpp", "common"},
+      {"errors.hpp", "common"},     {"expression.hpp", "model"},      {"expression_step.hpp", "model"},
+      {"footprint.hpp", "model"},   {"format.hpp", "common"},         {"grid.hpp", "model"},
+      {"grid_rules.hpp", "model"},  {"interval.hpp", "model"},        {"model.hpp", "model"},
+      {"model_export.hpp", "io"},   {"noise.hpp", "model"},           {"noise_sampler.hpp", "model"},
+      {"policy.hpp", "solve"},      {"policy_file.hpp", "io"},        {"resources.hpp", "common"},
+      {"roofline.hpp", "common"},   {"run_id.hpp", "common"},         {"scale_out.hpp", "common"},
+      {"stopwatch.hpp", "common"},  {"synthesis_types.hpp", "common"}, {"version.hpp", "common"}};
+  return folders;
+}
+
 // The first folder of a path relative to src/core ("" for a file directly in src/core).
 std::string top_folder(const std::string& relative) {
   const auto slash = relative.find('/');
   return slash == std::string::npos ? std::string() : relative.substr(0, slash);
 }
 
+// The layer an include names: an internal header's folder's, a public header's from the table;
+// -1 for a public header missing from it, -2 for a file of the same folder named by a subfolder path.
+int layer_of_include(const std::string& path) {
+  if (path.rfind("amytiss/", 0) == 0) {
+    const auto found = public_header_folders().find(path.substr(8));
+    return found == public_header_folders().end() ? -1 : layer_of(found->second);
+  }
+  const int layer = layer_of(top_folder(path));
+  return layer < 0 ? -2 : layer;
+}
+
+TEST(Layout, EveryPublicHeaderHasTheLayerOfItsFolder) {
+  const fs::path include = fs::path(AMYTISS_SOURCE_DIR) / "include/amytiss";
+  std::size_t headers = 0;
+  for (const auto& entry : fs::directory_iterator(include)) {
+    if (entry.path().extension() != ".hpp") continue;
+    ++headers;
+    const auto found = public_header_folders().find(entry.path().filename().string());
+    EXPECT_TRUE(found != public_header_folders().end())
+        << entry.path() << " has no layer: add it to public_header_folders()";
+  }
+  EXPECT_EQ(headers, public_header_folders().size()) << "a header of the table is gone: remove it there";
+  for (const auto& [header, folder] : public_header_folders())
+    EXPECT_GE(layer_of(folder), 0) << header << ": " << folder << " is no folder of kLayers";
+
+  // A source whose first include is a public header implements it, in the table's folder (but
+  // config/'s part of config.hpp, see above).
+  const fs::path core = fs::path(AMYTISS_SOURCE_DIR) / "src/core";
+  const std::regex first_public(R"re(^#include "amytiss/([a-z_]+\.hpp)")re");
+  std::size_t implementations = 0;
+  for (const auto& file : sources_under(core)) {
+    std::ifstream input(file);
+    std::string line;
+    while (std::getline(input, line))
+      if (line.rfind("#include", 0) == 0) break;
+    std::smatch match;
+    if (file.extension() != ".cpp" || !std::regex_search(line, match, first_public)) continue;
+    const auto found = public_header_folders().find(match[1].str());
+    const std::string folder = top_folder(fs::relative(file, core).generic_string());
+    if (found == public_header_folders().end() || (found->first == "config.hpp" && folder == "config")) continue;
+    ++implementations;
+    EXPECT_EQ(found->second, folder) << file.string() << " implements " << found->first << " in another layer";
+  }
+  EXPECT_GE(implementations, 15u);
+}
+
+// Each include in `file` (of layer `from`) that names a layer above it.
+void expect_includes_read_down(const fs::path& file, int from, std::size_t& checked) {
+  static const std::regex quoted_include(R"re(^\s*#\s*include\s*"([a-z_]+/[^"]+)")re");
+  std::ifstream input(file);
+  std::string line;
+  std::smatch match;
+  for (int number = 1; std::getline(input, line); ++number) {
+    if (!std::regex_search(line, match, quoted_include)) continue;
+    const int to = layer_of_include(match[1].str());
+    if (to == -2) continue;
+    ++checked;
+    EXPECT_GE(to, 0) << file.string() << ":" << number << " includes a public header without a layer: " << line;
+    EXPECT_LE(to, from) << file.string() << ":" << number << " reads up a layer: " << line;
+  }
+}
+
 TEST(Layout, CoreIncludesReadDownTheLayers) {
   const fs::path core = fs::path(AMYTISS_SOURCE_DIR) / "src/core";
-  const std::regex internal_include(R"re(^\s*#\s*include\s*"([a-z_]+/[^"]+)")re");
   std::size_t checked = 0;
   for (const auto& file : sources_under(core)) {
     const std::string from = top_folder(fs::relative(file, core).generic_string());
     ASSERT_GE(layer_of(from), 0) << file << " is in a folder without a layer: add it to kLayers";
-    std::ifstream input(file);
-    std::string line;
-    std::smatch match;
-    for (int number = 1; std::getline(input, line); ++number) {
-      if (!std::regex_search(line, match, internal_include) || match[1].str().rfind("amytiss/", 0) == 0) continue;
-      const std::string to = top_folder(match[1].str());
-      if (layer_of(to) < 0) continue;  // a file of the same folder named by a subfolder path
-      ++checked;
-      EXPECT_LE(layer_of(to), layer_of(from)) << file.string() << ":" << number << " reads up a layer: " << line;
-    }
+    expect_includes_read_down(file, layer_of(from), checked);
   }
-  EXPECT_GE(checked, 50u) << "too few internal includes found under " << core;
+  EXPECT_GE(checked, 300u) << "too few includes found under " << core;
+}
+
+TEST(Layout, PublicHeadersIncludeDownTheLayers) {
+  const fs::path include = fs::path(AMYTISS_SOURCE_DIR) / "include/amytiss";
+  std::size_t checked = 0;
+  for (const auto& [header, folder] : public_header_folders())
+    expect_includes_read_down(include / header, layer_of(folder), checked);
+  EXPECT_GE(checked, 20u) << "too few includes found under " << include;
 }
 
 TEST(Layout, RosIncludePatternMatchesWhatItMustRefuse) {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 #include "amytiss/errors.hpp"
+#include "common/require.hpp"
 #include "model/noise_laws.hpp"
 
 namespace amytiss {
@@ -26,9 +26,7 @@ MassInterval ratio_range(double num_lo, double num_hi, double s_lo, double s_hi)
   return {round_down(lo, MassBounds::kRoundingUlps), round_up(hi, MassBounds::kRoundingUlps)};
 }
 
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("MassBounds: ") + what);
-}
+constexpr detail::Require require{"MassBounds: "};
 
 }  // namespace
 

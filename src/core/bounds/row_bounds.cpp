@@ -2,32 +2,11 @@
 
 #include <algorithm>
 #include <cstring>
-#include <exception>
-#include <mutex>
-#include <thread>
 #include <unordered_map>
 
-namespace amytiss::detail {
+#include "common/parallel_for.hpp"
 
-void parallel_for(std::size_t count, unsigned threads,
-                  const std::function<void(unsigned part, std::size_t first, std::size_t last)>& body) {
-  threads = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, count)));
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto part = [&](unsigned t) {
-    try {
-      body(t, count * t / threads, count * (t + 1) / threads);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-    }
-  };
-  std::vector<std::thread> workers;
-  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(part, t);
-  part(0);
-  for (std::thread& worker : workers) worker.join();
-  if (failure) std::rethrow_exception(failure);
-}
+namespace amytiss::detail {
 
 std::vector<std::vector<std::size_t>> bounds_reads(const Abstraction& a) {
   const auto uses = a.dynamics->dependencies();
@@ -42,8 +21,6 @@ std::vector<std::vector<std::size_t>> bounds_reads(const Abstraction& a) {
   }
   return reads;
 }
-
-unsigned host_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 namespace {
 

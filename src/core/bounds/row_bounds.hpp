@@ -5,12 +5,12 @@
 // rows that share them (post coordinates that read few variables) share one entry, computed once.
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
 #include "bounds/omax/robust_expectation.hpp"
 #include "bounds/cell_roles.hpp"
+#include "common/parallel_for.hpp"  // the threads RowBounds and its users work on
 
 namespace amytiss::detail {
 
@@ -78,17 +78,8 @@ class RowBounds {
   std::size_t pool_size_ = 0;
 };
 
-/// Runs body(part, first, last) over [0, count) split into min(threads, count) contiguous parts
-/// (part 0, 1, ...) on as many threads (the calling thread takes part 0); rethrows the first
-/// exception of a part.
-void parallel_for(std::size_t count, unsigned threads,
-                  const std::function<void(unsigned part, std::size_t first, std::size_t last)>& body);
-
 /// RowBounds' `reads` for an abstraction: per dimension, what its coordinate of the map reads and
 /// the dimension itself (the noise's scale may depend on it); empty when the model does not say.
 std::vector<std::vector<std::size_t>> bounds_reads(const Abstraction& a);
-
-/// Worker threads for the host's interval MDP work: the hardware's concurrency (at least 1).
-unsigned host_threads();
 
 }  // namespace amytiss::detail

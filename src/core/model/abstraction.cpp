@@ -1,19 +1,17 @@
 #include "amytiss/abstraction.hpp"
 
 #include <chrono>
-#include <stdexcept>
 #include <string>
 
 #include "amytiss/errors.hpp"
 #include "amytiss/footprint.hpp"
+#include "common/require.hpp"
 
 namespace amytiss {
 namespace {
 
 // Inputs here passed Config::validate(); a violation is a bug of the caller.
-void require(bool invariant, const std::string& what) {
-  if (!invariant) throw std::logic_error("Abstraction: expected a validated configuration: " + what);
-}
+constexpr detail::Require require{"Abstraction: expected a validated configuration: "};
 
 void require_region(const Region& region, std::size_t dims) {
   require(!region.boxes.empty(), "sets of at least one box");

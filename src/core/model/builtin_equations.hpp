@@ -1,6 +1,6 @@
 #pragma once
 // The built-in models' vector fields (model/models/*.h) once more as expressions of the grammar,
-// for what the C functions cannot do: interval enclosures (bounds/enclosure.cpp). Same formulas,
+// for what the C functions cannot do: interval enclosures (model/enclosure.cpp). Same formulas,
 // same constants, same order of operations; test_enclosure.cpp checks them against the C
 // functions at random points.
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 // An interval with its interval gradient (forward-mode automatic differentiation over a box), for
-// the centred form of enclosures and the interval Jacobian (bounds/enclosure.cpp).
+// the centred form of enclosures and the interval Jacobian (model/enclosure.cpp).
 #include <string>
 #include <vector>
 

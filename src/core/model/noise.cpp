@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/require.hpp"
 #include "model/noise_laws.hpp"
 #include "model/normal_law.hpp"
 
@@ -22,9 +23,7 @@ using detail::upper_tail;
 constexpr double kMaxHalfCells = 1e15;
 
 // The constructor's input passed Config::validate(); a violation is a bug of the caller.
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("NoiseModel: expected a validated configuration: ") + what);
-}
+constexpr detail::Require require{"NoiseModel: expected a validated configuration: "};
 
 }  // namespace
 

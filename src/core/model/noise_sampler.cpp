@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 #include "amytiss/noise.hpp"
+#include "common/require.hpp"
 #include "model/noise_laws.hpp"
 
 namespace amytiss {
@@ -17,9 +17,7 @@ constexpr std::size_t kCdfPieces = 256;
 constexpr int kBisections = 60;
 
 // The sampler's input passed Config::validate(); a violation is a bug of the caller.
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("NoiseSampler: expected a validated configuration: ") + what);
-}
+constexpr detail::Require require{"NoiseSampler: expected a validated configuration: "};
 
 std::vector<double> normal_factor(const std::vector<double>& covariance, std::size_t n) {
   require(covariance.size() == n || covariance.size() == n * n, "covariance of n or n*n values");

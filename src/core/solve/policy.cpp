@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <string>
 
 namespace amytiss {
@@ -129,12 +128,6 @@ BoundsSummary summarize_bounds(const Policy& policy) {
   if (summary.free_cells)
     for (int k = 0; k < 3; ++k) ranges[k]->mean = sums[k] / double(summary.free_cells);
   return summary;
-}
-
-std::string new_run_id() {
-  std::random_device device;
-  const std::uint64_t id = (std::uint64_t(device()) << 32) ^ std::uint64_t(device());
-  return hex16(id);
 }
 
 }  // namespace amytiss

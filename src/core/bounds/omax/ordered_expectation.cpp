@@ -2,16 +2,15 @@
 
 #include <algorithm>
 #include <numeric>
-#include <stdexcept>
 
 #include "bounds/row_bounds.hpp"
+#include "common/parallel_for.hpp"
+#include "common/require.hpp"
 
 namespace amytiss::detail {
 namespace {
 
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("ordered expectation: ") + what);
-}
+constexpr Require require{"ordered expectation: "};
 
 // Lines up to this long visit only the window's cells (a bit per rank).
 constexpr std::size_t kMaskBits = 256;

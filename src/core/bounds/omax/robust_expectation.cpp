@@ -4,15 +4,13 @@
 #include <cmath>
 #include <functional>
 #include <numeric>
-#include <stdexcept>
-#include <string>
+
+#include "common/require.hpp"
 
 namespace amytiss::detail {
 namespace {
 
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("interval Bellman step: ") + what);
-}
+constexpr Require require{"interval Bellman step: "};
 
 }  // namespace
 

@@ -2,17 +2,16 @@
 
 #include <algorithm>
 #include <atomic>
-#include <stdexcept>
 
 #include "amytiss/format.hpp"
 #include "amytiss/stopwatch.hpp"
+#include "common/parallel_for.hpp"
+#include "common/require.hpp"
 
 namespace amytiss::detail {
 namespace {
 
-void require(bool invariant, const char* what) {
-  if (!invariant) throw std::logic_error(std::string("robust factored sweep: ") + what);
-}
+constexpr Require require{"robust factored sweep: "};
 
 // The index of each state, input and disturbance component among FactoredPlan::variables.
 std::size_t variable_of(const Abstraction& a, FactorVariable::Space space, std::size_t index) {

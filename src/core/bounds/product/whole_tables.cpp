@@ -4,6 +4,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "common/parallel_for.hpp"
+
 namespace amytiss::detail {
 namespace {
 

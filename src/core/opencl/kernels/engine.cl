@@ -29,7 +29,7 @@
 // offset of its window's first cell plus its per-dimension masses (zero where the window leaves
 // the grid or the truncation region).
 
-// Floats after a record in private mass arrays: compute_record() writes masses eight at a time.
+// Floats after a record in private mass arrays: normal_masses() writes masses eight at a time.
 #define MASS_SLACK 8
 
 // Point of a flat (row-major, last dimension fastest) grid index.
@@ -98,12 +98,109 @@ double8 erfc_nonnegative8x2(double8 z, double8 z2, double8* result2) {
 
 #if UNIFORM
 // Mass of [lo, hi] under the uniform law with the given mean and half-width `scale` (normal
-// masses come from the shared cell-bound tails in compute_record). Scale 0 is a point mass, 1
+// masses come from the shared cell-bound tails in normal_masses). Scale 0 is a point mass, 1
 // when lo <= mean < hi (as NoiseModel).
 double interval_mass(double lo, double hi, double mean, double scale) {
   if (scale <= 0.0) return (lo <= mean && mean < hi) ? 1.0 : 0.0;
   double overlap = fmin(hi, mean + scale) - fmax(lo, mean - scale);
   return overlap > 0.0 ? fmin(1.0, overlap / (2.0 * scale)) : 0.0;
+}
+#endif
+
+// Window of dimension dim for the post mean `mean`, placed in double exactly as Grid::nearest:
+// writes window_first[dim] and the kept range keep_first[dim]..keep_last[dim] of grid indices;
+// returns the padded offset along dim of the window's first cell.
+uint place_window(int dim, double mean, int* window_first, int* keep_first, int* keep_last) {
+  const int count = STATE_COUNT[dim];
+  const double eta = STATE_ETA[dim];
+  // A non-finite post state has no cell: all its mass leaves the grid.
+  const bool finite = isfinite(mean);
+  // Truncation keeps nearest +- KEEP_HALF (NoiseModel's h, which may exceed the grid; the
+  // layout's half_cells is capped at count - 1). Clamp before converting so that far-away
+  // means cannot overflow the integer: beyond this range nothing is kept either way.
+  const long keep_half = KEEP_HALF[dim];
+  double nearest_real = floor((mean - STATE_LB[dim]) / eta + 0.5);
+  nearest_real = fmax(fmin(nearest_real, (double)(count + keep_half + 1)), (double)(-keep_half - 2));
+  const long nearest = finite ? (long)nearest_real : -keep_half - 2;
+  // A whole-grid dimension's window is the grid itself, from index 0 (HALF_CELLS is 0 there).
+  const int start = WHOLE_DIM[dim] ? 0 : (int)clamp(nearest, 0L, (long)(count - 1));
+#if TRUNCATION_NONE
+  keep_first[dim] = 0;
+  keep_last[dim] = finite ? count - 1 : -1;
+#else
+  keep_first[dim] = (int)max(nearest - keep_half, 0L);
+  keep_last[dim] = (int)min(nearest + keep_half, (long)(count - 1));
+#endif
+  window_first[dim] = start - HALF_CELLS[dim];
+  // Padded index of grid cell start - half is start.
+  return (uint)start * (uint)PADDED_STRIDE[dim];
+}
+
+#if UNIFORM
+// Masses of dimension dim's window under the uniform law, zero outside the kept range.
+void uniform_masses(int dim, double mean, double scale, int window_first, int keep_first, int keep_last,
+                    float* m) {
+  for (int j = 0; j < WIDTH[dim]; ++j) {
+    const int k = window_first + j;
+    // The bounds as NoiseModel::cell_mass writes them: neighbours share a bound exactly.
+    const double mass = interval_mass(STATE_LB[dim] + ((double)k - 0.5) * STATE_ETA[dim],
+                                      STATE_LB[dim] + ((double)k + 0.5) * STATE_ETA[dim], mean, scale);
+    m[MASS_OFFSET[dim] + j] = (k >= keep_first && k <= keep_last) ? (float)mass : 0.0f;
+  }
+}
+#else
+// Dimension dim's cell bounds and the arguments of their erfc evaluations, |b - mean| / (scale
+// sqrt 2), in slots dim * BOUNDS_CAPACITY onwards of bound and tail.
+void bound_arguments(int dim, double mean, double scale, int window_first, double* bound, double* tail) {
+  const double eta = STATE_ETA[dim];
+  const double inverse = scale > 0.0 ? 1.0 / (scale * 1.4142135623730951) : 0.0;
+  for (int b = 0; b < BOUNDS_CAPACITY; ++b) {
+    const int slot = dim * BOUNDS_CAPACITY + b;
+    bound[slot] = STATE_LB[dim] + ((double)(window_first + b) - 0.5) * eta;
+    tail[slot] = fabs(bound[slot] - mean) * inverse;
+  }
+}
+
+// tail(b) = erfc(|b - mean| / (scale sqrt 2)) / 2, the mass beyond b on the far side, in place of
+// every dimension's arguments at once, so that the erfc runs with the most lanes in flight.
+void bound_tails(double* tail) {
+  int b = 0;
+  for (; b + 16 <= STATE_DIMS * BOUNDS_CAPACITY; b += 16) {
+    double8 second;
+    const double8 first = erfc_nonnegative8x2(vload8(0, tail + b), vload8(1, tail + b), &second);
+    vstore8(0.5 * first, 0, tail + b);
+    vstore8(0.5 * second, 1, tail + b);
+  }
+  if (b < STATE_DIMS * BOUNDS_CAPACITY)
+    vstore8(0.5 * erfc_nonnegative8(vload8(0, tail + b)), 0, tail + b);
+}
+
+// Masses of dimension dim's window under the normal law from its bounds' tails, zero outside the
+// kept range, eight cells at a time: a vector may run past the dimension's window into the next
+// one's masses (rewritten right after) or into the MASS_SLACK floats after the record, which
+// every caller's array has.
+void normal_masses(int dim, double mean, double scale, int window_first, int keep_first, int keep_last,
+                   const double* bound, const double* tail, float* m) {
+  // One erfc per cell bound (not two per cell); every difference subtracts tails on one side
+  // of the mean, accurate to ~1e-16 in absolute terms, far below the float the mass is stored
+  // in. Lane for lane the rule lo >= mean: tail(lo) - tail(hi); hi <= mean: tail(hi) - tail(lo);
+  // otherwise 1 - tail(lo) - tail(hi). Scale 0 is a point mass in [lo, hi).
+  const double8 mean8 = (double8)(mean);
+  for (int j = 0; j < WIDTH[dim]; j += 8) {
+    const int slot = dim * BOUNDS_CAPACITY + j;
+    const double8 lo = vload8(0, bound + slot), hi = vload8(0, bound + slot + 1);
+    const double8 tail_lo = vload8(0, tail + slot), tail_hi = vload8(0, tail + slot + 1);
+    double8 mass;
+    if (scale <= 0.0) {
+      mass = select((double8)(0.0), (double8)(1.0), (lo <= mean8) & (mean8 < hi));
+    } else {
+      const double8 straddling = select(1.0 - tail_lo - tail_hi, tail_hi - tail_lo, hi <= mean8);
+      mass = select(straddling, tail_lo - tail_hi, lo >= mean8);
+    }
+    const int8 k = (int8)(window_first + j) + (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+    const int8 kept = (k >= (int8)(keep_first)) & (k <= (int8)(keep_last));
+    vstore8(select((float8)(0.0f), convert_float8(mass), kept), 0, m + MASS_OFFSET[dim] + j);
+  }
 }
 #endif
 
@@ -131,90 +228,27 @@ uint compute_record(ulong state, ulong input, ulong disturbance, float* m) {
   double bound[STATE_DIMS * BOUNDS_CAPACITY + 8], tail[STATE_DIMS * BOUNDS_CAPACITY + 8];
 #endif
   for (int dim = 0; dim < STATE_DIMS; ++dim) {
-    const int count = STATE_COUNT[dim];
-    const double eta = STATE_ETA[dim];
     mean[dim] = post[dim];
 #if MULTIPLICATIVE
     scale[dim] = NOISE_SCALE[dim] * fabs(x[dim]);
 #else
     scale[dim] = NOISE_SCALE[dim];
 #endif
-    // A non-finite post state has no cell: all its mass leaves the grid.
-    const bool finite = isfinite(mean[dim]);
-    // Truncation keeps nearest +- KEEP_HALF (NoiseModel's h, which may exceed the grid; the
-    // layout's half_cells is capped at count - 1). Clamp before converting so that far-away
-    // means cannot overflow the integer: beyond this range nothing is kept either way.
-    const long keep_half = KEEP_HALF[dim];
-    double nearest_real = floor((mean[dim] - STATE_LB[dim]) / eta + 0.5);
-    nearest_real = fmax(fmin(nearest_real, (double)(count + keep_half + 1)), (double)(-keep_half - 2));
-    const long nearest = finite ? (long)nearest_real : -keep_half - 2;
-    // A whole-grid dimension's window is the grid itself, from index 0 (HALF_CELLS is 0 there).
-    const int start = WHOLE_DIM[dim] ? 0 : (int)clamp(nearest, 0L, (long)(count - 1));
-#if TRUNCATION_NONE
-    keep_first[dim] = 0;
-    keep_last[dim] = finite ? count - 1 : -1;
-#else
-    keep_first[dim] = (int)max(nearest - keep_half, 0L);
-    keep_last[dim] = (int)min(nearest + keep_half, (long)(count - 1));
-#endif
-    window_first[dim] = start - HALF_CELLS[dim];
-    // Padded index of grid cell start - half is start.
-    offset += (uint)start * (uint)PADDED_STRIDE[dim];
+    offset += place_window(dim, mean[dim], window_first, keep_first, keep_last);
 #if !UNIFORM
-    const double inverse = scale[dim] > 0.0 ? 1.0 / (scale[dim] * 1.4142135623730951) : 0.0;
-    for (int b = 0; b < BOUNDS_CAPACITY; ++b) {
-      const int slot = dim * BOUNDS_CAPACITY + b;
-      bound[slot] = STATE_LB[dim] + ((double)(window_first[dim] + b) - 0.5) * eta;
-      tail[slot] = fabs(bound[slot] - mean[dim]) * inverse;
-    }
+    bound_arguments(dim, mean[dim], scale[dim], window_first[dim], bound, tail);
 #endif
   }
+  // Pass 2 (normal law): the tails of every cell bound.
 #if !UNIFORM
-  // Pass 2: tail(b) = erfc(|b - mean| / (scale sqrt 2)) / 2, the mass beyond b on the far side.
-  int b = 0;
-  for (; b + 16 <= STATE_DIMS * BOUNDS_CAPACITY; b += 16) {
-    double8 second;
-    const double8 first = erfc_nonnegative8x2(vload8(0, tail + b), vload8(1, tail + b), &second);
-    vstore8(0.5 * first, 0, tail + b);
-    vstore8(0.5 * second, 1, tail + b);
-  }
-  if (b < STATE_DIMS * BOUNDS_CAPACITY)
-    vstore8(0.5 * erfc_nonnegative8(vload8(0, tail + b)), 0, tail + b);
+  bound_tails(tail);
 #endif
-  // Pass 3: the masses, zero outside the kept range. Normal law: eight cells at a time; a vector
-  // may run past the dimension's window into the next one's masses (rewritten right after) or
-  // into the MASS_SLACK floats after the record, which every caller's array has.
+  // Pass 3: the masses, zero outside the kept range.
   for (int dim = 0; dim < STATE_DIMS; ++dim) {
 #if UNIFORM
-    for (int j = 0; j < WIDTH[dim]; ++j) {
-      const int k = window_first[dim] + j;
-      // The bounds as NoiseModel::cell_mass writes them: neighbours share a bound exactly.
-      const double mass = interval_mass(STATE_LB[dim] + ((double)k - 0.5) * STATE_ETA[dim],
-                                        STATE_LB[dim] + ((double)k + 0.5) * STATE_ETA[dim], mean[dim],
-                                        scale[dim]);
-      m[MASS_OFFSET[dim] + j] = (k >= keep_first[dim] && k <= keep_last[dim]) ? (float)mass : 0.0f;
-    }
+    uniform_masses(dim, mean[dim], scale[dim], window_first[dim], keep_first[dim], keep_last[dim], m);
 #else
-    // One erfc per cell bound (not two per cell); every difference subtracts tails on one side
-    // of the mean, accurate to ~1e-16 in absolute terms, far below the float the mass is stored
-    // in. Lane for lane the rule lo >= mean: tail(lo) - tail(hi); hi <= mean: tail(hi) - tail(lo);
-    // otherwise 1 - tail(lo) - tail(hi). Scale 0 is a point mass in [lo, hi).
-    const double8 mean8 = (double8)(mean[dim]);
-    for (int j = 0; j < WIDTH[dim]; j += 8) {
-      const int slot = dim * BOUNDS_CAPACITY + j;
-      const double8 lo = vload8(0, bound + slot), hi = vload8(0, bound + slot + 1);
-      const double8 tail_lo = vload8(0, tail + slot), tail_hi = vload8(0, tail + slot + 1);
-      double8 mass;
-      if (scale[dim] <= 0.0) {
-        mass = select((double8)(0.0), (double8)(1.0), (lo <= mean8) & (mean8 < hi));
-      } else {
-        const double8 straddling = select(1.0 - tail_lo - tail_hi, tail_hi - tail_lo, hi <= mean8);
-        mass = select(straddling, tail_lo - tail_hi, lo >= mean8);
-      }
-      const int8 k = (int8)(window_first[dim] + j) + (int8)(0, 1, 2, 3, 4, 5, 6, 7);
-      const int8 kept = (k >= (int8)(keep_first[dim])) & (k <= (int8)(keep_last[dim]));
-      vstore8(select((float8)(0.0f), convert_float8(mass), kept), 0, m + MASS_OFFSET[dim] + j);
-    }
+    normal_masses(dim, mean[dim], scale[dim], window_first[dim], keep_first[dim], keep_last[dim], bound, tail, m);
 #endif
   }
   return offset;
