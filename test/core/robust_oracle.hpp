@@ -11,6 +11,8 @@
 // dimension the bounds come from MassBounds (bounds/mass_bounds.hpp); the rows are the joint
 // interval MDP or the product set (bounds/omax/robust_expectation.hpp).
 #include <algorithm>
+#include <functional>
+#include <stdexcept>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -24,6 +26,42 @@
 #include "bounds/omax/robust_expectation.hpp"
 
 namespace amytiss::detail {
+
+/// The product bound with the dimensions eliminated in `order` (post dimensions e_1..e_d: e_1's
+/// intervals applied first to the values, e_d's last), row by row: the oracle of the factored
+/// product sweep (bounds/product/elimination.hpp). The order (d-1, ..., 0) is product_expectation()'s,
+/// bit for bit; every order gives a sound bound (another one in general).
+inline double product_expectation_in_order(const Grid& states, const DimensionView* dimensions, const double* values,
+                                           Bound bound, const std::vector<std::size_t>& order) {
+  const std::size_t dims = states.dims();
+  if (order.size() != dims) throw std::logic_error("product_expectation_in_order: an order of every dimension");
+  std::vector<std::size_t> multi(dims, 0);
+  std::vector<OutcomeSlack> scratch;
+  // Level k eliminates order[k - 1] with the dimensions order[k..] fixed in `multi`; level 0 reads
+  // the values. As eliminate(): an outcome that can get no mass needs no value.
+  std::function<double(std::size_t)> level = [&](std::size_t k) -> double {
+    if (k == 0) return values[states.flat_index(multi.data())];
+    const std::size_t d = order[k - 1];
+    const DimensionView& window = dimensions[d];
+    const std::size_t cells = window.count;
+    std::vector<double> lo(cells + 2), hi(cells + 2), line(cells + 2);
+    for (std::size_t j = 0; j < cells; ++j) {
+      lo[j] = window.cells[j].lo;
+      hi[j] = window.cells[j].hi;
+      multi[d] = std::size_t(window.first) + j;
+      line[j] = hi[j] > 0.0 ? level(k - 1) : 0.0;
+    }
+    multi[d] = 0;
+    lo[cells] = window.leave.lo;
+    hi[cells] = window.leave.hi;
+    line[cells] = 0.0;
+    lo[cells + 1] = window.cut.lo;
+    hi[cells + 1] = window.cut.hi;
+    line[cells + 1] = cut_value(bound);
+    return robust_expectation(lo.data(), hi.data(), line.data(), cells + 2, bound, scratch);
+  };
+  return level(dims);
+}
 
 /// The rows' ambiguity sets: the joint interval MDP (each row's masses bounded cell by cell) or
 /// the product of the per-dimension sets (the bounds engine's product methods).

@@ -15,6 +15,7 @@
 
 #include "amytiss/enclosure.hpp"
 #include "amytiss/engine.hpp"
+#include "robust_oracle.hpp"
 #include "bounds/mean_box.hpp"
 #include "bounds/robust_step.hpp"
 #include "bounds/product/elimination.hpp"

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <numeric>
 
 #include "common/require.hpp"
@@ -189,38 +188,6 @@ double product_expectation(const Grid& states, const DimensionView* dimensions, 
     }
   }
   return eliminate(dimensions, dims, values, bound, scratch, 0, 0);
-}
-
-double product_expectation_in_order(const Grid& states, const DimensionView* dimensions, const double* values,
-                                    Bound bound, const std::vector<std::size_t>& order) {
-  const std::size_t dims = states.dims();
-  require(order.size() == dims, "an order of every dimension");
-  std::vector<std::size_t> multi(dims, 0);
-  std::vector<OutcomeSlack> scratch;
-  // Level k eliminates order[k - 1] with the dimensions order[k..] fixed in `multi`; level 0 reads
-  // the values. As eliminate(): an outcome that can get no mass needs no value.
-  std::function<double(std::size_t)> level = [&](std::size_t k) -> double {
-    if (k == 0) return values[states.flat_index(multi.data())];
-    const std::size_t d = order[k - 1];
-    const DimensionView& window = dimensions[d];
-    const std::size_t cells = window.count;
-    std::vector<double> lo(cells + 2), hi(cells + 2), line(cells + 2);
-    for (std::size_t j = 0; j < cells; ++j) {
-      lo[j] = window.cells[j].lo;
-      hi[j] = window.cells[j].hi;
-      multi[d] = std::size_t(window.first) + j;
-      line[j] = hi[j] > 0.0 ? level(k - 1) : 0.0;
-    }
-    multi[d] = 0;
-    lo[cells] = window.leave.lo;
-    hi[cells] = window.leave.hi;
-    line[cells] = 0.0;
-    lo[cells + 1] = window.cut.lo;
-    hi[cells + 1] = window.cut.hi;
-    line[cells + 1] = cut_value(bound);
-    return robust_expectation(lo.data(), hi.data(), line.data(), cells + 2, bound, scratch);
-  };
-  return level(dims);
 }
 
 double product_expectation(const Grid& states, const std::vector<DimensionBounds>& dimensions, const double* values,

@@ -99,11 +99,5 @@ struct ProductScratch {
 /// product_expectation() of one row given as one view per state dimension.
 double product_expectation(const Grid& states, const DimensionView* dimensions, const double* values, Bound bound,
                            ProductScratch& scratch);
-/// The product bound with the dimensions eliminated in `order` (post dimensions e_1..e_d: e_1's
-/// intervals applied first to the values, e_d's last), row by row: the oracle of the factored
-/// product sweep (bounds/product/elimination.hpp). The order (d-1, ..., 0) is product_expectation()'s,
-/// bit for bit; every order gives a sound bound (another one in general).
-double product_expectation_in_order(const Grid& states, const DimensionView* dimensions, const double* values,
-                                    Bound bound, const std::vector<std::size_t>& order);
 
 }  // namespace amytiss::detail

@@ -18,9 +18,10 @@
 //
 // This is the product set's recursive bound in the order e_1..e_d: sound in every order (each
 // stage may pick its distribution per remaining cell, a superset of the product set), and equal,
-// up to rounding, to product_expectation_in_order() of each row in the same order. It pays where
-// coordinates read few components (building automation: 7 dimensions, each reading 2 to 4), where
-// the row-by-row product bound recomputes the same lines for every row.
+// up to rounding, to the tests' product_expectation_in_order() (test/core/robust_oracle.hpp) of
+// each row in the same order. It pays where coordinates read few components (building
+// automation: 7 dimensions, each reading 2 to 4), where the row-by-row product bound recomputes
+// the same lines for every row.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
