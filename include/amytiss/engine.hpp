@@ -28,7 +28,7 @@ Policy synthesize(const Abstraction& abstraction, const SynthesisOptions& option
 /// time step; one line each (amytiss_synth --dry-run). Collective over the communicator's ranks.
 std::vector<std::string> describe_synthesis(const Abstraction& abstraction, const SynthesisOptions& options);
 
-/// Memory a synthesis needs, in bytes, as the OpenCL engine lays it out (docs/engine.md).
+/// Memory a synthesis needs, in bytes, as the engines lay it out (docs/engine.md, "The plan").
 struct MemoryEstimate {
   double policy_bytes = 0;             ///< policy arrays as in the file: float64 values of every
                                        ///< step (and upper bounds), uint32 input indices, uint8 roles
@@ -36,8 +36,18 @@ struct MemoryEstimate {
                                        ///< float32 cell masses of every dimension's window; 0 under
                                        ///< guarantee: system, which stores no transitions
   double stored_transition_bytes = 0;  ///< bytes_per_triple times the state-input-disturbance triples
+  /// guarantee: system: the bounds engine's peak besides the policy arrays (the row bounds, their
+  /// construction and the method's buffers, bounds_method's or, for auto, the dearest it may choose)
+  double bounds_bytes = 0;
+  std::string bounds_method;           ///< guarantee: system: the method bounds_bytes counts
+  /// What the host's memory must hold: policy_bytes plus bounds_bytes (guarantee: system), or the
+  /// policy arrays alone (guarantee: abstraction: the stored transitions live on the OpenCL
+  /// device, whose memory the sweep's choice weighs). Compared with available_memory().
+  double host_bytes = 0;
 };
+/// For the abstraction's compute section, or `compute` (the method and the threads it names).
 MemoryEstimate estimate_memory(const Abstraction& abstraction);
+MemoryEstimate estimate_memory(const Abstraction& abstraction, const ComputeConfig& compute);
 
 /// The serial reference engine directly, whatever the configuration's compute section says; for
 /// guarantee: system, the joint interval MDP's bounds on one thread (bounds_method joint: the

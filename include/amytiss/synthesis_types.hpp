@@ -116,6 +116,10 @@ struct SynthesisOptions {
   /// The ranks of an MPI run (docs/scale_out.md); null: this process alone. With several ranks
   /// or compute.devices, the OpenCL engine splits the work and every rank returns the whole policy.
   Communicator* communicator = nullptr;
+  /// The host memory the run may take, in bytes; 0: what available_memory() finds (the least of
+  /// MemAvailable, the cgroup's limit and RLIMIT_AS). The plan refuses a run whose estimate
+  /// (estimate_memory()) exceeds it, before anything is allocated.
+  double memory_limit_bytes = 0;
 };
 
 }  // namespace amytiss

@@ -41,12 +41,15 @@ void print_sizes(const Abstraction& abstraction) {
 }
 
 // The engine's estimate (docs/engine.md): policy arrays as in the file, stored transitions as
-// the OpenCL engine stores them; the continuous-system bounds store none.
+// the OpenCL engine stores them; the continuous-system bounds store none but their row bounds
+// and the method's buffers take host memory.
 void print_memory_estimate(const Abstraction& abstraction) {
   const MemoryEstimate estimate = estimate_memory(abstraction);
   if (abstraction.config.guarantee == Guarantee::System) {
-    std::printf("estimated memory: policy arrays %s (lower and upper bounds), no stored transitions\n",
-                format_bytes(estimate.policy_bytes).c_str());
+    std::printf("estimated memory: policy arrays %s (lower and upper bounds), bounds engine %s (row bounds and "
+                "method %s), host %s in all, no stored transitions\n",
+                format_bytes(estimate.policy_bytes).c_str(), format_bytes(estimate.bounds_bytes).c_str(),
+                estimate.bounds_method.c_str(), format_bytes(estimate.host_bytes).c_str());
     return;
   }
   std::printf("estimated memory: policy arrays %s, stored transitions %s (%.0f bytes per triple)\n",

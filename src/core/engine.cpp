@@ -4,6 +4,8 @@
 
 #include "amytiss/format.hpp"
 #include "amytiss/run_id.hpp"
+#include "bounds/memory_estimate.hpp"
+#include "common/parallel_for.hpp"
 #include "execute.hpp"
 #include "serial/reference_engine.hpp"
 #include "opencl/device.hpp"
@@ -27,7 +29,9 @@ std::vector<std::string> describe_synthesis(const Abstraction& abstraction, cons
   return detail::describe_plan(abstraction, plan, options);
 }
 
-MemoryEstimate estimate_memory(const Abstraction& abstraction) {
+MemoryEstimate estimate_memory(const Abstraction& abstraction) { return estimate_memory(abstraction, abstraction.config.compute); }
+
+MemoryEstimate estimate_memory(const Abstraction& abstraction, const ComputeConfig& compute) {
   const double cells = double(abstraction.states.size());
   const double horizon = double(abstraction.horizon);
   MemoryEstimate estimate;
@@ -39,7 +43,15 @@ MemoryEstimate estimate_memory(const Abstraction& abstraction) {
     estimate.policy_bytes += cells * sizeof(double);
   else if (system)
     estimate.policy_bytes += (horizon + 1) * cells * sizeof(double);
-  if (system) return estimate;  // the bounds store no transitions, only per-dimension intervals
+  estimate.host_bytes = estimate.policy_bytes;
+  if (system) {  // the bounds store no transitions, only per-dimension intervals
+    const unsigned threads = compute.device == DeviceKind::Reference ? 1u : detail::host_threads();
+    const detail::BoundsMemory bounds = detail::estimate_bounds_memory(abstraction, compute.bounds_method, threads);
+    estimate.bounds_bytes = bounds.peak();
+    estimate.bounds_method = bounds.method;
+    estimate.host_bytes += estimate.bounds_bytes;
+    return estimate;
+  }
   estimate.bytes_per_triple = double(detail::Layout(abstraction).record_bytes());
   estimate.stored_transition_bytes = estimate.bytes_per_triple * double(abstraction.triples());
   return estimate;

@@ -3,7 +3,9 @@
 #include "plan.hpp"
 
 
+#include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
+#include "amytiss/resources.hpp"
 #include "amytiss/format.hpp"
 #include "bounds/system_engine.hpp"
 #include "opencl/layout.hpp"
@@ -41,6 +43,34 @@ bool serial_pays(const Abstraction& a, SynthesisPlan& plan) {
   note(plan, "device auto: an OpenCL device (" + work + ", above the serial engine's " +
                  format_significant(kSerialMultiplyAdds) + ")");
   return false;
+}
+
+// The grid whose eta to change: the one with the most points among those the estimate grows with
+// (the row bounds grow with states x inputs x disturbances, the policy arrays with the states).
+std::string memory_key(const Abstraction& a, bool rows) {
+  if (!rows || (a.states.size() >= a.inputs.size() && a.states.size() >= a.disturbances.size()))
+    return "states.eta";
+  return a.inputs.size() >= a.disturbances.size() ? "inputs.eta" : "disturbances.eta";
+}
+
+void check_host_memory(const Abstraction& a, const SynthesisOptions& options, SynthesisPlan& plan) {
+  const MemoryEstimate estimate = estimate_memory(a, options.compute);
+  const HostMemory available = available_memory(options.memory_limit_bytes);
+  const bool system = a.config.guarantee == Guarantee::System;
+  const std::string need = format_significant(estimate.host_bytes) + " bytes (" + format_bytes(estimate.host_bytes) +
+                           (system ? ": policy arrays " + format_bytes(estimate.policy_bytes) + ", bounds " +
+                                         format_bytes(estimate.bounds_bytes) + " for " + estimate.bounds_method
+                                   : ": policy arrays") +
+                           ")";
+  const std::string limit = format_significant(available.bytes) + " bytes (" + format_bytes(available.bytes) + ", " +
+                            available.source + ")";
+  if (estimate.host_bytes > available.bytes) {
+    const std::string key = memory_key(a, system);
+    throw ConfigError(key, "the run needs an estimated " + need + " of host memory, more than the " + limit +
+                               " this process may use; expected a coarser grid (a larger " + key +
+                               ", fewer points)" + (system ? " or fewer inputs or disturbances" : " or a shorter spec.horizon"));
+  }
+  note(plan, "host memory: an estimated " + need + " of " + limit);
 }
 
 void plan_bounds(const SynthesisOptions& options, EngineScope scope, SynthesisPlan& plan) {
@@ -110,6 +140,7 @@ SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& optio
     note(plan, "footprint: " + footprint_work_text(a.config.states, a.config.spec) + " to find the cells it may touch, " +
                    "at most " + format_number(kMaxFootprintBoxTests) + " accepted");
   const bool any = scope == EngineScope::Any;
+  check_host_memory(a, options, plan);
   if (a.config.guarantee == Guarantee::System) {
     plan_bounds(options, scope, plan);
     return plan;

@@ -188,7 +188,7 @@ TEST_F(CliTest, SystemGuaranteePrintsBothBoundsAndComparesThem) {
        {"continuous-system bounds over", "lower (V_0, this policy) min", "upper (any controller)   min",
         "gap (upper - lower)      min", "a-priori error of the abstraction (paper's bound): ",
         "max |d lower V_0| (engine - reference): ", "max |d upper V_0| (engine - reference): ",
-        "(lower and upper bounds), no stored transitions"})
+        "(lower and upper bounds), bounds engine ", "in all, no stored transitions"})
     EXPECT_CONTAINS(result.out, line);
   EXPECT_EQ(result.out.find("bytes per triple"), std::string::npos) << "the bounds store no transitions";
 }
