@@ -31,15 +31,6 @@ constexpr double kSampleRounding = 1e-12;
 constexpr double kHandTolerance = 1e-12;
 constexpr std::uint64_t kSeed = 20261201;
 
-Footprint car(double length, double width, double rear_overhang) {
-  Footprint footprint;
-  footprint.pose = {0, 1, 2};
-  footprint.length = length;
-  footprint.width = width;
-  footprint.rear_overhang = rear_overhang;
-  return footprint;
-}
-
 TEST(FootprintBox, HoldsTheBodyAtSampledPosesOfTheCellAndSoDoThePieces) {
   std::mt19937_64 random(kSeed);
   auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };

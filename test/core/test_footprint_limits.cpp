@@ -28,15 +28,6 @@ constexpr int kPosesPerCell = 200;
 // A cancelled setup ends within this: the footprint's loop polls every kPollSeconds.
 constexpr double kCancelSeconds = 0.5;
 
-Footprint car(double length, double width, double rear_overhang) {
-  Footprint footprint;
-  footprint.pose = {0, 1, 2};
-  footprint.length = length;
-  footprint.width = width;
-  footprint.rear_overhang = rear_overhang;
-  return footprint;
-}
-
 // The lane of test_footprint.cpp: x = 0..10 (eta 1), one y cell [-0.5, 0.5], one yaw cell
 // [-0.05, 0.05]; the obstacle x in [8, 9], y in [-0.2, 0.2].
 Grid lane() { return Grid(grid_spec({0, 0, 0}, {10, 0, 0}, {1, 1, 0.1})); }

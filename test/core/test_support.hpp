@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
+#include "amytiss/footprint.hpp"
 #include "amytiss/format.hpp"
 #include "amytiss/config.hpp"
 #include "amytiss/errors.hpp"
@@ -33,6 +34,16 @@
 
 namespace amytiss {
 namespace test_support {
+
+/// A car-like body on the pose components (x, y, yaw) = state dimensions (0, 1, 2), in metres.
+inline Footprint car(double length, double width, double rear_overhang) {
+  Footprint footprint;
+  footprint.pose = {0, 1, 2};
+  footprint.length = length;
+  footprint.width = width;
+  footprint.rear_overhang = rear_overhang;
+  return footprint;
+}
 
 /// Dynamics from a C++ callable. `opencl_body` is the body of amytiss_dynamics in OpenCL C (the
 /// statements that fill post[] from x[], u[], w[]); empty when the test never runs OpenCL.
