@@ -5,7 +5,7 @@
 #include "amytiss/format.hpp"
 #include "amytiss/run_id.hpp"
 #include "bounds/memory_estimate.hpp"
-#include "common/parallel_for.hpp"
+#include "bounds/system_engine.hpp"
 #include "execute.hpp"
 #include "serial/reference_engine.hpp"
 #include "opencl/device.hpp"
@@ -45,7 +45,7 @@ MemoryEstimate estimate_memory(const Abstraction& abstraction, const ComputeConf
     estimate.policy_bytes += (horizon + 1) * cells * sizeof(double);
   estimate.host_bytes = estimate.policy_bytes;
   if (system) {  // the bounds store no transitions, only per-dimension intervals
-    const unsigned threads = compute.device == DeviceKind::Reference ? 1u : detail::host_threads();
+    const unsigned threads = detail::bounds_threads(compute.device == DeviceKind::Reference);
     const detail::BoundsMemory bounds = detail::estimate_bounds_memory(abstraction, compute.bounds_method, threads);
     estimate.bounds_bytes = bounds.peak();
     estimate.bounds_method = bounds.method;

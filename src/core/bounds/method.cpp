@@ -16,28 +16,17 @@ namespace {
 
 MethodChoice choose_bounds_method(const Abstraction& a, const RowBounds& rows, BoundsMethod requested) {
   MethodChoice choice;
-  switch (requested) {
-    case BoundsMethod::Joint:
-    case BoundsMethod::Rows:
-      choice.method = requested;
-      choice.reason = "forced by compute.bounds_method";
-      return choice;
-    case BoundsMethod::WholeTables:
-      if (!ProductSweep::fits(a.states, rows))
-        refuse(requested, "its tables need more than " + std::to_string(ProductSweep::kMaxTableEntries) + " entries");
-      choice.method = requested;
-      choice.reason = "forced by compute.bounds_method";
-      return choice;
-    case BoundsMethod::Elimination: {
+  if (requested != BoundsMethod::Auto) {
+    if (requested == BoundsMethod::WholeTables && !ProductSweep::fits(a.states, rows))
+      refuse(requested, "its tables need more than " + std::to_string(ProductSweep::kMaxTableEntries) + " entries");
+    if (requested == BoundsMethod::Elimination) {
       std::string no_plan;
       choice.plan = RobustFactoredSweep::plan(a, &no_plan);
       if (!choice.plan) refuse(requested, no_plan);
-      choice.method = requested;
-      choice.reason = "forced by compute.bounds_method";
-      return choice;
     }
-    case BoundsMethod::Auto:
-      break;
+    choice.method = requested;
+    choice.reason = "forced by compute.bounds_method";
+    return choice;
   }
   if (ProductSweep::pays(a.states, rows, a.triples())) {
     choice.method = BoundsMethod::WholeTables;

@@ -13,7 +13,7 @@
 namespace amytiss::detail {
 
 Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial, StepReporter& reporter) {
-  const unsigned threads = serial ? 1u : host_threads();
+  const unsigned threads = bounds_threads(serial);
   reporter.set_device(serial ? "reference"
                              : "host (" + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") + ")");
   reporter.reached(Phase::Setup);
@@ -103,5 +103,7 @@ RolesText lower_roles_text(const Grid& states, const SpecConfig& spec, const std
   out.text += ": the lower bound is 0 everywhere" + no_cell_reason(states, spec, kept);
   return out;
 }
+
+unsigned bounds_threads(bool serial) { return serial ? 1u : host_threads(); }
 
 }  // namespace amytiss::detail

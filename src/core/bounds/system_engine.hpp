@@ -17,6 +17,9 @@ namespace amytiss::detail {
 /// gives the system map (ImageEnclosure) and the sets.
 Policy run_system_bounds(const Abstraction& abstraction, BoundsMethod method, bool serial, StepReporter& reporter);
 
+/// The threads the bounds run on: one when `serial` (device reference), else the host's.
+unsigned bounds_threads(bool serial);
+
 /// What the lower bound's roles (`lower_roles`: robust_cell_roles()) leave it. Reach
 /// specifications: "891 of 60125 cells lie wholly inside the target (the lower bound's target
 /// cells)". Safety: empty while some cell is kept. With no cell (the lower bound 0 everywhere, a

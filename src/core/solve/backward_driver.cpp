@@ -2,7 +2,6 @@
 #include "solve/backward_driver.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 
 #include "amytiss/errors.hpp"
 #include "amytiss/resources.hpp"
@@ -120,10 +119,6 @@ Policy run_backward(const Abstraction& a, ValueSequence lower, const ValueSequen
   }
   reporter.report().host_peak_bytes = peak_resident_bytes();
   return policy;
-}
-
-void BellmanStep::evaluate(const double*, double*, const std::uint32_t*) {
-  throw std::logic_error("this Bellman step cannot evaluate a fixed controller: only the host's steps can");
 }
 
 }  // namespace amytiss::detail
