@@ -34,6 +34,8 @@ std::string robot_yaml(const std::string& states_eta, const std::string& inputs_
 
 // Peak resident set of one synthesis above what the process holds before it: the peak is reset
 // to the resident set first (clear_refs 5), the heap's free memory given back.
+constexpr double kMostEstimatePerPeak = 2.0;
+
 struct Measured {
   double peak_bytes = 0, estimate_bytes = 0;
 };
@@ -61,9 +63,8 @@ TEST(HostMemory, AvailableMemoryIsTheLeastLimitKnown) {
   EXPECT_EQ(limited.source, "a limit of the caller");
 }
 
-// The estimate covers the bounds engine's measured peak, for shapes that take different methods:
-// a 2-d grid, a 3-d system, many inputs. Where rows share their mean boxes (which only the row
-// bounds know), it counts more than the run takes: at most 4 times the peak here.
+// The estimate covers the bounds engine's measured peak, and is within twice it, for shapes that
+// take different methods: a 2-d grid and many inputs (whole tables), a 3-d system (elimination).
 void expect_estimate_covers_peak(const std::string& yaml) {
   const Abstraction a = from_yaml(yaml);
   const Measured measured = measure(a);
@@ -72,7 +73,7 @@ void expect_estimate_covers_peak(const std::string& yaml) {
               a.states.size(), a.inputs.size(), a.disturbances.size(),
               estimate_memory(a).bounds_method.c_str());
   EXPECT_GE(measured.estimate_bytes, measured.peak_bytes);
-  EXPECT_LE(measured.estimate_bytes, 4 * measured.peak_bytes);
+  EXPECT_LE(measured.estimate_bytes, kMostEstimatePerPeak * measured.peak_bytes);
 }
 
 TEST(HostMemory, EstimateCoversThePeakOfA2dGrid) { expect_estimate_covers_peak(robot_yaml("0.05", "1", "system", "1")); }

@@ -191,6 +191,39 @@ TEST(RobustFactored, TuplesThatShareAWindowShareASearch) {
   expect_every_row_in_the_plans_order(a, rows, *plan);
 }
 
+// The plan alone says which stages run as a pair (what the memory estimate counts), as the sweep
+// pairs them; the mean boxes of a cell per combination of what each dimension reads count the
+// distinct bounds that the row bounds store for every cell (and at least those for some).
+TEST(RobustFactored, ThePlanAndTheMeanBoxesGiveTheSweepsRunsAndTheDistinctBounds) {
+  const Abstraction a = from_yaml(shared_windows_yaml());
+  const ImageEnclosure enclosure(a.config);
+  std::string reason;
+  const std::optional<FactoredPlan> plan = RobustFactoredSweep::plan(a, &reason);
+  ASSERT_TRUE(plan) << reason;
+  std::vector<bool> some(a.states.size());
+  for (std::size_t cell = 0; cell < some.size(); cell += 3) some[cell] = true;
+  for (const std::vector<bool>& needed : {std::vector<bool>(a.states.size(), true), some}) {
+    const MeanBox mean_box = enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances);
+    const RowBounds rows(a.states, a.inputs, a.disturbances, *a.noise, mean_box, needed, 2, bounds_reads(a));
+    const RobustFactoredSweep sweep(a, rows, needed, *plan, Bound::Lower, 2);
+    const auto runs = RobustFactoredSweep::stage_runs(*plan, a.states.counts());
+    ASSERT_EQ(runs.size(), sweep.runs().size());
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      EXPECT_EQ(runs[r].first, sweep.runs()[r].first);
+      EXPECT_EQ(runs[r].last, sweep.runs()[r].last);
+    }
+    const auto counted = count_distinct_bounds(a, mean_box, 2, std::size_t(1) << 20);
+    ASSERT_TRUE(counted);
+    for (std::size_t d = 0; d < a.states.dims(); ++d) {
+      if (needed == some)
+        EXPECT_GE((*counted)[d], rows.distinct_bounds(d)) << d;
+      else
+        EXPECT_EQ((*counted)[d], rows.distinct_bounds(d)) << d;
+    }
+    EXPECT_FALSE(count_distinct_bounds(a, mean_box, 2, 1));  // past its budget
+  }
+}
+
 // Long lines and narrow windows: the sweep over whole tables does not pay, variable elimination
 // does; a reach-avoid specification with a disturbance.
 std::string narrow_2d_yaml() {

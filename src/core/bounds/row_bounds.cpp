@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <atomic>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "common/parallel_for.hpp"
 
@@ -46,6 +48,51 @@ struct WorkerTables {
 };
 
 }  // namespace
+
+RowBounds::BoundsKey bounds_key(const Grid& states, const MassBounds& mass, std::size_t d, std::size_t k, double lo,
+                                double hi) {
+  const MassInterval scale = mass.scale_range(states.face(d, std::int64_t(k)), states.face(d, std::int64_t(k) + 1));
+  return {lo, hi, scale.lo, scale.hi};
+}
+
+std::optional<std::vector<std::size_t>> count_distinct_bounds(const Abstraction& a, const MeanBox& mean_box,
+                                                              unsigned threads, std::size_t max_keys) {
+  const std::size_t dims = a.states.dims(), rows_per_cell = a.inputs.size() * a.disturbances.size();
+  const std::vector<std::vector<std::size_t>> reads = bounds_reads(a);
+  std::vector<std::size_t> distinct(dims);
+  for (std::size_t d = 0; d < dims; ++d) {
+    // A dimension's bounds depend only on the coordinates it reads: one cell per combination of
+    // those (the others at index 0), every row of it.
+    std::vector<std::size_t> read = reads.empty() ? std::vector<std::size_t>{} : reads[d];
+    if (read.empty())
+      for (std::size_t j = 0; j < dims; ++j) read.push_back(j);
+    std::size_t tuples = 1;
+    for (std::size_t j : read) tuples *= a.states.count(j);
+    const MassBounds mass(*a.noise, d);
+    using KeySet = std::unordered_set<BoundsKey, BoundsKeyHash, BoundsKeyEqual>;
+    const unsigned workers = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, tuples)));
+    std::vector<KeySet> sets(workers);
+    std::atomic<bool> too_many{false};
+    parallel_for(tuples, workers, [&](unsigned worker, std::size_t first, std::size_t last) {
+      std::vector<double> lo(dims), hi(dims);
+      std::vector<std::size_t> multi(dims, 0);
+      for (std::size_t tuple = first; tuple < last && !too_many; ++tuple) {
+        for (std::size_t rest = tuple, j = read.size(); j-- > 0; rest /= a.states.count(read[j]))
+          multi[read[j]] = rest % a.states.count(read[j]);
+        const std::size_t cell = a.states.flat_index(multi.data());
+        for (std::size_t r = 0; r < rows_per_cell; ++r) {
+          mean_box(cell, r / a.disturbances.size(), r % a.disturbances.size(), lo.data(), hi.data());
+          sets[worker].insert(bounds_key(a.states, mass, d, multi[d], lo[d], hi[d]));
+        }
+        if (sets[worker].size() > max_keys) too_many = true;
+      }
+    });
+    if (too_many) return std::nullopt;
+    for (unsigned worker = 1; worker < workers; ++worker) sets[0].insert(sets[worker].begin(), sets[worker].end());
+    distinct[d] = sets[0].size();
+  }
+  return distinct;
+}
 
 // Per dimension, the rows of one worker that share a mean box and scale: key = the cell's index
 // over the dimensions read, times the rows per cell, plus the row within the cell.
@@ -117,9 +164,7 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
         mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
         for (std::size_t d = 0; d < dims_; ++d) {
           if (slots[d] && *slots[d] != SharedBounds::kUnknown) continue;
-          const auto k = std::int64_t(multi[d]);
-          const MassInterval scale = per_dimension[d].scale_range(states.face(d, k), states.face(d, k + 1));
-          const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
+          const BoundsKey key = bounds_key(states, per_dimension[d], d, multi[d], lo[d], hi[d]);
           const auto found = table.index[d].emplace(key, std::uint32_t(table.keys[d].size()));
           index_[r * dims_ + d] = found.first->second;
           if (slots[d]) *slots[d] = found.first->second;

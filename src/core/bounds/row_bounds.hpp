@@ -5,6 +5,7 @@
 // rows that share them (post coordinates that read few variables) share one entry, computed once.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "amytiss/abstraction.hpp"
@@ -77,6 +78,17 @@ class RowBounds {
   std::vector<MassInterval> pool_;  // the views point into it
   std::size_t pool_size_ = 0;
 };
+
+/// The key of dimension d's bounds of a row whose mean interval along d is [lo, hi] (state units),
+/// in a cell of index k along d.
+RowBounds::BoundsKey bounds_key(const Grid& states, const MassBounds& mass, std::size_t d, std::size_t k, double lo,
+                                double hi);
+/// Per dimension, how many distinct bounds the rows of every cell have (what RowBounds stores
+/// when every cell is needed; at least what it stores for some), from the mean boxes of one cell
+/// per combination of the coordinates the dimension reads, on `threads` workers; nothing once a
+/// worker meets more than `max_keys`.
+std::optional<std::vector<std::size_t>> count_distinct_bounds(const Abstraction& a, const MeanBox& mean_box,
+                                                              unsigned threads, std::size_t max_keys);
 
 /// RowBounds' `reads` for an abstraction: per dimension, what its coordinate of the map reads and
 /// the dimension itself (the noise's scale may depend on it); empty when the model does not say.

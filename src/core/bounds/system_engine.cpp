@@ -9,6 +9,7 @@
 #include "bounds/robust_iteration.hpp"
 #include "bounds/robust_step.hpp"
 #include "bounds/row_bounds.hpp"
+#include "common/host_memory.hpp"
 
 namespace amytiss::detail {
 
@@ -38,6 +39,8 @@ Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial,
   reporter.report().transitions = "interval bounds per dimension: " + format_bytes(double(rows.bytes())) +
                                   " on the host (" + std::to_string(rows.intervals()) + " mass intervals)";
   reporter.reached(Phase::Construction);
+  // The construction's tables are freed; without this they stay resident beside the method's buffers.
+  release_free_heap();
   // The backward driver runs the two bounds' steps one after the other: one set of sweep buffers.
   const auto sweep_buffers = std::make_shared<SweepBuffers>();
   const MethodChoice choice = choose_bounds_method(a, rows, method);

@@ -1,5 +1,9 @@
 #include "common/host_memory.hpp"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <sys/mman.h>
 
 #include <algorithm>
@@ -29,6 +33,12 @@ double* HostDoubles::reserve(std::size_t count) {
     capacity_ = count;
   }
   return data();
+}
+
+void release_free_heap() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
 }
 
 }  // namespace amytiss::detail

@@ -9,6 +9,10 @@
 
 namespace amytiss::detail {
 
+/// Gives the heap's free pages back to the system (glibc keeps freed small blocks resident):
+/// between phases, so that one phase's temporaries do not add to the next phase's peak.
+void release_free_heap();
+
 class HostBlock {
  public:
   /// At least `bytes` (rounded up to whole 2 MiB), untouched; throws std::bad_alloc.

@@ -57,7 +57,7 @@ RobustFactoredSweep::RobustFactoredSweep(const Abstraction& a, const RowBounds& 
     walks_.push_back(StageWalk::of(stage, plan_.variables));
     walks_.back().share_searches(window_of_[stage.dimension], packed_[stage.dimension].size());
   }
-  pair_stages();
+  runs_ = stage_runs(plan_, counts_);
 }
 
 void RobustFactoredSweep::gather_windows(const Abstraction& a, const RowBounds& rows,
@@ -139,29 +139,34 @@ void RobustFactoredSweep::prepare(const double* values) {
   }
 }
 
-void RobustFactoredSweep::pair_stages() {
+std::vector<RobustFactoredSweep::StageRun> RobustFactoredSweep::stage_runs(const FactoredPlan& plan,
+                                                                           const std::vector<std::size_t>& counts) {
   // The pairs that leave the most entries of stage tensors unwritten: saved[k], the most from
   // stage k on; a stage is in one pair at most.
-  const std::size_t stages = plan_.stages.size();
+  const std::size_t stages = plan.stages.size();
   std::vector<std::size_t> saved(stages + 2, 0);
   for (std::size_t k = stages; k-- > 0;) {
     saved[k] = saved[k + 1];
-    if (fuses_next(k)) saved[k] = std::max(saved[k], std::size_t(plan_.stages[k].output_size) + saved[k + 2]);
+    if (fuses_next(plan, counts, k))
+      saved[k] = std::max(saved[k], std::size_t(plan.stages[k].output_size) + saved[k + 2]);
   }
+  std::vector<StageRun> runs;
   for (std::size_t k = 0; k < stages;) {
     const std::size_t last = saved[k] != saved[k + 1] ? k + 1 : k;
-    runs_.push_back({k, last});
+    runs.push_back({k, last});
     k = last + 1;
   }
+  return runs;
 }
 
-bool RobustFactoredSweep::fuses_next(std::size_t k) const {
-  if (k + 1 >= plan_.stages.size() || walks_[k].carried.empty()) return false;
-  const StageWalk::Carried& fastest = walks_[k].carried[0];
-  const FactoredStage& next = plan_.stages[k + 1];
+bool RobustFactoredSweep::fuses_next(const FactoredPlan& plan, const std::vector<std::size_t>& counts, std::size_t k) {
+  if (k + 1 >= plan.stages.size()) return false;
+  const std::vector<StageWalk::Carried> carried = StageWalk::carried_of(plan.stages[k], plan.variables);
+  if (carried.empty()) return false;
+  const FactoredStage& next = plan.stages[k + 1];
   // The fastest digit of stage k's lines is the post cell that stage k + 1 contracts: it has that
   // digit's stride in stage k's output, and its count.
-  return fastest.output_stride == next.contracted_stride && fastest.radix == counts_[next.dimension];
+  return carried[0].output_stride == next.contracted_stride && carried[0].radix == counts[next.dimension];
 }
 
 bool RobustFactoredSweep::sorts(std::size_t k) const {
@@ -216,7 +221,7 @@ void RobustFactoredSweep::run_fused(std::size_t k, const double* in, std::size_t
   const auto [dim, length, stride, lines] = lines_of(k, in_size);
   const StageWalk& walk = walks_[k];
   const std::size_t applied = walk.free_offsets.size();
-  require(fuses_next(k), "stage k's lines give stage k + 1's");
+  require(fuses_next(plan_, counts_, k), "stage k's lines give stage k + 1's");
   const std::size_t next_dim = plan_.stages[k + 1].dimension, next_length = counts_[next_dim];
   const StageWalk& next_walk = walks_[k + 1];
   const std::size_t next_applied = next_walk.free_offsets.size();

@@ -76,6 +76,9 @@ class RobustFactoredSweep {
     double seconds = 0.0;
   };
   const std::vector<StageRun>& runs() const { return runs_; }
+  /// The runs that a sweep of `plan` takes, from the plan alone (counts: state cells per
+  /// dimension): the pairs that leave the most entries of the stage tensors unwritten.
+  static std::vector<StageRun> stage_runs(const FactoredPlan& plan, const std::vector<std::size_t>& counts);
   /// Whether stage k runs as a pair with stage k + 1.
   bool fused_with_next(std::size_t k) const {
     for (const StageRun& run : runs_)
@@ -98,10 +101,7 @@ class RobustFactoredSweep {
   // written out.
   void run_fused(std::size_t k, const double* in, std::size_t in_size, double* out);
   // Whether stage k's lines, a run at a time, give whole lines of stage k + 1.
-  bool fuses_next(std::size_t k) const;
-  // Fills runs_: the stage pairs that run_fused() takes are those that leave the most entries of
-  // W_k unwritten.
-  void pair_stages();
+  static bool fuses_next(const FactoredPlan& plan, const std::vector<std::size_t>& counts, std::size_t k);
   // Whether stage k sorts its lines.
   bool sorts(std::size_t k) const;
   // Per post dimension, the distinct windows of the tuples of the components it reads (tuple

@@ -4,32 +4,53 @@
 #include <numeric>
 
 namespace amytiss::detail {
+namespace {
+
+// An input or disturbance: lines that differ in one may hold far-apart values.
+bool jumps(const TensorDigit& digit, const std::vector<FactorVariable>& variables) {
+  return !digit.post && variables[digit.id].space != FactorVariable::Space::State;
+}
+
+}  // namespace
+
+std::vector<StageWalk::Carried> StageWalk::carried_of(const FactoredStage& stage,
+                                                      const std::vector<FactorVariable>& variables) {
+  std::vector<Carried> carried;
+  std::size_t output_stride = stage.output_size;
+  for (std::size_t j = 0; j < stage.output.size(); ++j) {
+    output_stride /= stage.output[j].radix;
+    if (!stage.input_stride[j]) continue;
+    carried.push_back({stage.output[j].radix, std::size_t(stage.input_stride[j]), output_stride,
+                       std::size_t(stage.tuple_stride[j]), jumps(stage.output[j], variables)});
+  }
+  // Lines that differ in a state or post cell hold close values (a line is sorted from the one
+  // before); lines of another input or disturbance may not: those digits count slowest. The others
+  // by input stride, for the caches.
+  std::stable_sort(carried.begin(), carried.end(), [](const Carried& a, const Carried& b) {
+    return a.jumps != b.jumps ? b.jumps : a.input_stride < b.input_stride;
+  });
+  return carried;
+}
 
 StageWalk StageWalk::of(const FactoredStage& stage, const std::vector<FactorVariable>& variables) {
   StageWalk walk;
+  walk.carried = carried_of(stage, variables);
   walk.free_offsets.assign(1, 0);
   walk.free_tuples.assign(1, 0);
   std::vector<std::size_t> jumps_of(1, 0);  // per combination: its input and disturbance digits, as one number
-  // An input or disturbance: lines that differ in one may hold far-apart values.
-  auto jumps = [&](const TensorDigit& digit) {
-    return !digit.post && variables[digit.id].space != FactorVariable::Space::State;
-  };
   std::size_t output_stride = stage.output_size;
   for (std::size_t j = 0; j < stage.output.size(); ++j) {
     const std::size_t radix = stage.output[j].radix;
     output_stride /= radix;
+    if (stage.input_stride[j]) continue;
     const auto tuple_stride = std::size_t(stage.tuple_stride[j]);
-    if (stage.input_stride[j]) {
-      walk.carried.push_back({radix, std::size_t(stage.input_stride[j]), output_stride, tuple_stride,
-                              jumps(stage.output[j])});
-      continue;
-    }
+    const bool digit_jumps = jumps(stage.output[j], variables);
     std::vector<std::size_t> offsets, tuples, jump_digits;
     for (std::size_t i = 0; i < walk.free_offsets.size(); ++i)
       for (std::size_t digit = 0; digit < radix; ++digit) {
         offsets.push_back(walk.free_offsets[i] + digit * output_stride);
         tuples.push_back(walk.free_tuples[i] + digit * tuple_stride);
-        jump_digits.push_back(jumps(stage.output[j]) ? jumps_of[i] * radix + digit : jumps_of[i]);
+        jump_digits.push_back(digit_jumps ? jumps_of[i] * radix + digit : jumps_of[i]);
       }
     walk.free_offsets.swap(offsets);
     walk.free_tuples.swap(tuples);
@@ -39,12 +60,6 @@ StageWalk StageWalk::of(const FactoredStage& stage, const std::vector<FactorVari
   std::iota(walk.free_order.begin(), walk.free_order.end(), 0u);
   std::stable_sort(walk.free_order.begin(), walk.free_order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return jumps_of[a] < jumps_of[b]; });
-  // Lines that differ in a state or post cell hold close values (a line is sorted from the one
-  // before); lines of another input or disturbance may not: those digits count slowest. The others
-  // by input stride, for the caches.
-  std::stable_sort(walk.carried.begin(), walk.carried.end(), [](const Carried& a, const Carried& b) {
-    return a.jumps != b.jumps ? b.jumps : a.input_stride < b.input_stride;
-  });
   return walk;
 }
 

@@ -33,6 +33,8 @@ struct StageWalk {
   std::vector<std::uint32_t> search_of;
 
   static StageWalk of(const FactoredStage& stage, const std::vector<FactorVariable>& variables);
+  /// The carried digits alone (what `of` puts in `carried`), without the combinations.
+  static std::vector<Carried> carried_of(const FactoredStage& stage, const std::vector<FactorVariable>& variables);
   /// Fills searched and search_of where the windows do not depend on the line; window_of[tuple]:
   /// the window of each tuple, `windows` of them.
   void share_searches(const std::vector<std::uint32_t>& window_of, std::size_t windows);

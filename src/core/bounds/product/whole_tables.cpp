@@ -7,16 +7,7 @@
 #include "common/parallel_for.hpp"
 
 namespace amytiss::detail {
-namespace {
-
-// A scan is cheaper than robust_expectation()'s sort while the line is at most this many times
-// longer than the window.
-constexpr std::size_t kScanLengthPerOutcome = 4;
-
-}  // namespace
-
 bool ProductSweep::pays(const Grid& states, const RowBounds& rows, std::size_t row_count) {
-  constexpr std::size_t kLinesPerRow = 64;
   std::size_t prefixes = 1;
   for (std::size_t d = 0; d < states.dims(); ++d) {
     std::size_t window_cells = 0;

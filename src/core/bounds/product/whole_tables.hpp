@@ -35,6 +35,11 @@ class ProductSweep {
  public:
   /// At most this many table entries (a double and a 32-bit position each).
   static constexpr std::size_t kMaxTableEntries = std::size_t(1) << 24;
+  /// It pays only where no stage computes more lines than this per row, and no dimension's line is
+  /// longer than this many times its average window (a scan, cheaper than robust_expectation()'s
+  /// sort while the line is not much longer, reads the whole line).
+  static constexpr std::size_t kLinesPerRow = 64;
+  static constexpr std::size_t kScanLengthPerOutcome = 4;
   /// Whether the sweep pays for these rows (`row_count` of them): its tables fit
   /// kMaxTableEntries, no stage computes more lines than 64 per row, and every dimension's line
   /// is at most 4 times as long as its average window (a scan reads the whole line). Otherwise
