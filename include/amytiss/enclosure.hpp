@@ -19,6 +19,10 @@ struct ImageBox {
   /// False when f may be undefined (NaN) at some x in the cell: `box` then holds the values where
   /// f is defined, and a caller that needs every image must treat the cell as unbounded.
   bool defined = true;
+  /// enclose() only (natural() leaves it empty): per coordinate i, a lower bound of |df_i/dx_i|
+  /// over the cell, so that moving x_i by d moves f_i by at least expansion[i] * |d| (0 where the
+  /// coordinate may jump in the cell or its derivative in x_i may vanish or change sign).
+  std::vector<double> expansion;
 };
 
 /// entries[i][j] contains the partial derivative of f_i in x_j at every x of the cell.

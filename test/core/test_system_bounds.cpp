@@ -477,8 +477,8 @@ TEST(SystemBounds, AlignedSetsCheckFindsAMeanBoxOffTheImage) {
   const ImageEnclosure enclosure(a.config);
   const MeanBox image = enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances);
   const double eta = a.states.eta()[0];
-  const MeanBox moved = [&](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi) {
-    image(cell, u, w, lo, hi);
+  const MeanBox moved = [&](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi, double* expansion) {
+    image(cell, u, w, lo, hi, expansion);
     *lo += eta;
     *hi += eta;
   };
@@ -497,7 +497,7 @@ constexpr double kOutwardRounding = 1e-10;
 
 void expect_point_boxes_reproduce_the_abstraction(const std::string& yaml) {
   const Abstraction a = from_yaml(yaml);
-  const MeanBox point = [&a](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi) {
+  const MeanBox point = [&a](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi, double*) {
     const std::vector<double> x = a.states.point(cell), input = a.inputs.point(u), d = a.disturbances.point(w);
     a.dynamics->evaluate(x.data(), input.data(), d.data(), lo);
     std::copy(lo, lo + a.states.dims(), hi);

@@ -28,7 +28,8 @@ MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, 
   std::vector<double> quanta;
   for (double width : states.eta()) quanta.push_back(binary_quantum(width));
   return [&enclosure, &states, &inputs, &disturbances, quanta](std::size_t cell, std::size_t input,
-                                                               std::size_t disturbance, double* lo, double* hi) {
+                                                               std::size_t disturbance, double* lo, double* hi,
+                                                               double* expansion) {
     const std::vector<double> centre = states.point(cell);
     IntervalBox box;
     for (std::size_t j = 0; j < centre.size(); ++j)
@@ -41,6 +42,7 @@ MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, 
       const bool known = image.defined && !image.box[i].is_empty();
       lo[i] = known ? floor_to(image.box[i].lo, quanta[i]) : -kInfinity;
       hi[i] = known ? ceil_to(image.box[i].hi, quanta[i]) : kInfinity;
+      expansion[i] = image.expansion[i];
     }
   };
 }

@@ -9,7 +9,8 @@ namespace amytiss::detail {
 
 /// For state cell `cell` of `states` (the box c +- eta/2 around its point), the points of `inputs`
 /// and `disturbances` (grids of no dimension: none), writes ImageEnclosure::enclose(), rounded
-/// outward to multiples of a power of two at most 2^-40 of the cell's width (per dimension). Where
+/// outward to multiples of a power of two at most 2^-40 of the cell's width (per dimension), and its
+/// expansion (ImageBox::expansion). Where
 /// the map may be undefined in the cell the box is the whole space (-inf, +inf): every mass is then
 /// unknown. `enclosure` and the grids must outlive the returned function.
 MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,

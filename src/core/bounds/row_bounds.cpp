@@ -4,6 +4,7 @@
 #include <cstring>
 #include <unordered_map>
 
+#include "bounds/lattice.hpp"
 #include "common/parallel_for.hpp"
 
 namespace amytiss::detail {
@@ -31,7 +32,7 @@ struct BoundsKeyEqual {
 };
 struct BoundsKeyHash {
   std::size_t operator()(const BoundsKey& key) const {
-    std::uint64_t words[4];
+    std::uint64_t words[5];
     std::memcpy(words, &key, sizeof words);
     std::uint64_t hash = 0x9e3779b97f4a7c15ull;
     for (std::uint64_t word : words) hash = (hash ^ word) * 0x100000001b3ull + (hash >> 29);
@@ -97,7 +98,7 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
     table.keys.resize(dims_);
     table.index.resize(dims_);
     SharedBounds shared(states, rows_per_cell, reads);
-    std::vector<double> lo(dims_), hi(dims_);
+    std::vector<double> lo(dims_), hi(dims_), expansion(dims_);
     std::vector<std::size_t> multi(dims_);
     std::vector<std::uint32_t*> slots(dims_);
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
@@ -114,12 +115,13 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
             known = false;
         }
         if (known) continue;
-        mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
+        std::fill(expansion.begin(), expansion.end(), 0.0);
+        mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data(), expansion.data());
         for (std::size_t d = 0; d < dims_; ++d) {
           if (slots[d] && *slots[d] != SharedBounds::kUnknown) continue;
           const auto k = std::int64_t(multi[d]);
           const MassInterval scale = per_dimension[d].scale_range(states.face(d, k), states.face(d, k + 1));
-          const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi};
+          const BoundsKey key{lo[d], hi[d], scale.lo, scale.hi, noise_free(noise, d) ? expansion[d] : 0.0};
           const auto found = table.index[d].emplace(key, std::uint32_t(table.keys[d].size()));
           index_[r * dims_ + d] = found.first->second;
           if (slots[d]) *slots[d] = found.first->second;
@@ -142,6 +144,12 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
       }
     }
   }
+  lattice_.assign(dims_, false);
+  for (std::size_t d = 0; d < dims_; ++d) {
+    lattice_[d] = noise_free(noise, d);
+    for (const BoundsKey& key : keys[d])
+      lattice_[d] = lattice_[d] && lattice_row(states, d, key.m_lo, key.m_hi, key.expansion);
+  }
   compute_bounds(states, per_dimension, keys, threads);
   parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
@@ -160,8 +168,9 @@ void RowBounds::compute_bounds(const Grid& states, const std::vector<MassBounds>
     bounds[d].resize(keys[d].size());
     parallel_for(keys[d].size(), threads, [&](unsigned, std::size_t first, std::size_t last) {
       for (std::size_t i = first; i < last; ++i)
-        bounds[d][i] = per_dimension[d].dimension_bounds(states, keys[d][i].m_lo, keys[d][i].m_hi, keys[d][i].s_lo,
-                                                         keys[d][i].s_hi);
+        bounds[d][i] = lattice_[d] ? lattice_bounds(states, d, keys[d][i].m_lo, keys[d][i].m_hi)
+                                   : per_dimension[d].dimension_bounds(states, keys[d][i].m_lo, keys[d][i].m_hi,
+                                                                       keys[d][i].s_lo, keys[d][i].s_hi);
     });
     for (const DimensionBounds& one : bounds[d]) pool_size_ += one.cells.size();
   }

@@ -1,5 +1,7 @@
 #include "amytiss/enclosure.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "amytiss/expression.hpp"
@@ -156,6 +158,11 @@ ImageBox ImageEnclosure::enclose(const IntervalBox& cell, const std::vector<doub
   const Jets at_centre = map_->over(centre_box, u, w, false);
   ImageBox image = image_of(jets);
   for (std::size_t i = 0; i < jets.size(); ++i) {
+    // Lebourg's theorem along x_i: f_i(x + d e_i) - f_i(x) lies in J_ii(X) d, so a J_ii of one
+    // sign moves f_i by at least its least magnitude times |d|.
+    const Interval& own = jets[i].gradient[i];
+    const bool one_sign = jets[i].smooth && !own.is_empty() && !own.contains_zero();
+    image.expansion.push_back(one_sign ? std::min(std::fabs(own.lo), std::fabs(own.hi)) : 0.0);
     if (!jets[i].smooth || !at_centre[i].value.defined) continue;
     Interval centred = at_centre[i].value;
     for (std::size_t j = 0; j < cell.size(); ++j) centred = centred + jets[i].gradient[j] * (cell[j] - centre_box[j]);
