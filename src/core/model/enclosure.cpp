@@ -66,7 +66,7 @@ struct ImageEnclosure::Map {
     return state;
   }
 
-  void check(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  void check(const IntervalBox& cell, const std::vector<double>& u, const IntervalBox& w) const {
     if (cell.size() != state_dims || u.size() != input_dims || w.size() != disturbance_dims)
       throw std::logic_error("ImageEnclosure: expected a cell of " + std::to_string(state_dims) + " states, " +
                              std::to_string(input_dims) + " inputs and " + std::to_string(disturbance_dims) +
@@ -78,15 +78,22 @@ struct ImageEnclosure::Map {
     for (double value : values) jets.push_back(IntervalJet::constant(Interval::point(value), dims));
     return jets;
   }
+  // The disturbance enters like an input that ranges over an interval: no gradient (the
+  // enclosures' derivatives are in x only).
+  Jets ranges(const IntervalBox& values, std::size_t dims) const {
+    Jets jets;
+    for (const Interval& value : values) jets.push_back(IntervalJet::constant(value, dims));
+    return jets;
+  }
 
-  // f over the cell; with gradients (dims = state_dims) or without (dims = 0).
-  Jets over(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w, bool gradients) const {
+  // f over the cell and the disturbances' box; with gradients (dims = state_dims) or without (dims = 0).
+  Jets over(const IntervalBox& cell, const std::vector<double>& u, const IntervalBox& w, bool gradients) const {
     check(cell, u, w);
     const std::size_t dims = gradients ? state_dims : 0;
     Jets x;
     for (std::size_t j = 0; j < cell.size(); ++j)
       x.push_back(gradients ? IntervalJet::variable(cell[j], j, dims) : IntervalJet::constant(cell[j], 0));
-    return step(x, points(u, dims), points(w, dims), dims);
+    return step(x, points(u, dims), ranges(w, dims), dims);
   }
 };
 
@@ -135,23 +142,42 @@ std::size_t ImageEnclosure::state_dims() const { return map_->state_dims; }
 std::size_t ImageEnclosure::input_dims() const { return map_->input_dims; }
 std::size_t ImageEnclosure::disturbance_dims() const { return map_->disturbance_dims; }
 
+namespace {
+IntervalBox point_box(const std::vector<double>& values) {
+  IntervalBox box;
+  for (double value : values) box.push_back(Interval::point(value));
+  return box;
+}
+}  // namespace
+
 ImageBox ImageEnclosure::natural(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  return natural_over(cell, u, point_box(w));
+}
+
+ImageBox ImageEnclosure::natural_over(const IntervalBox& cell, const std::vector<double>& u,
+                                      const IntervalBox& w) const {
   return image_of(map_->over(cell, u, w, false));
 }
 
 IntervalJacobian ImageEnclosure::jacobian(const IntervalBox& cell, const std::vector<double>& u,
                                           const std::vector<double>& w) const {
   IntervalJacobian jacobian;
-  for (const IntervalJet& jet : map_->over(cell, u, w, true)) {
+  for (const IntervalJet& jet : map_->over(cell, u, point_box(w), true)) {
     jacobian.entries.push_back(jet.gradient);
     jacobian.valid.push_back(jet.smooth);
   }
   return jacobian;
 }
 
-// Mean-value theorem (Lebourg's for the Lipschitz |.|, min, max): f_i(x) - f_i(c) lies in
-// sum_j J_ij(X) (x_j - c_j) for x in X, so f_i(X) lies in f_i(c) + sum_j J_ij(X) (X_j - c_j).
 ImageBox ImageEnclosure::enclose(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  return enclose_over(cell, u, point_box(w));
+}
+
+// Mean-value theorem (Lebourg's for the Lipschitz |.|, min, max), at each fixed w of W: f_i(x, w) -
+// f_i(c, w) lies in sum_j J_ij(X, W) (x_j - c_j) for x in X, so f_i(X, W) lies in
+// f_i(c, W) + sum_j J_ij(X, W) (X_j - c_j).
+ImageBox ImageEnclosure::enclose_over(const IntervalBox& cell, const std::vector<double>& u,
+                                      const IntervalBox& w) const {
   const Jets jets = map_->over(cell, u, w, true);
   IntervalBox centre_box;
   for (const Interval& component : cell) centre_box.push_back(Interval::point(component.mid()));
