@@ -10,8 +10,8 @@
 // `expansion` times any move of x_i (the least |df_i/dx_i| over the cell, 0 when unknown), and a
 // target [a_t, b_t], a source coordinate with margin r maps to margin at least r - lattice_loss()
 // in the target. A dimension whose every row loses at most kLatticeSlack * eta keeps, over n steps,
-// every state that starts more than n * kLatticeSlack * eta inside its cell strictly inside the
-// cells the rows name.
+// every state that starts more than n * kLatticeSlack * eta (plus the lookup's rounding) inside its
+// cell strictly inside the cells the rows name.
 #include <cstddef>
 #include <cstdint>
 
