@@ -22,6 +22,7 @@
 #include "amytiss/enclosure.hpp"
 #include "bounds/cell_roles.hpp"
 #include "bounds/mean_box.hpp"
+#include "bounds/lattice.hpp"
 #include "bounds/mass_bounds.hpp"
 #include "bounds/omax/robust_expectation.hpp"
 
@@ -97,28 +98,40 @@ inline double role_value(CellRole role, SpecType spec) {
   return spec == SpecType::Safety ? 1.0 : 0.0;
 }
 
-// The bounds of every (cell, input, disturbance) row of the Free cells, per dimension.
+// The bounds of every (cell, input, disturbance) row of the Free cells, per dimension; a lattice
+// dimension (bounds/lattice.hpp: noise-free, every row's mean box within one cell) gets the
+// point masses of lattice_bounds().
 inline std::vector<std::vector<DimensionBounds>> oracle_row_bounds(const RobustProblem& p) {
   const std::size_t dims = p.states.dims();
   std::vector<MassBounds> per_dimension;
   for (std::size_t d = 0; d < dims; ++d) per_dimension.emplace_back(p.noise, d);
   const std::size_t inputs = p.inputs.size(), disturbances = p.disturbances.size();
-  std::vector<std::vector<DimensionBounds>> rows(p.states.size() * inputs * disturbances);
-  std::vector<double> lo(dims), hi(dims);
-  std::vector<std::size_t> multi(dims);
+  const std::size_t row_count = p.states.size() * inputs * disturbances;
+  std::vector<std::vector<double>> lo(row_count), hi(row_count);
+  std::vector<bool> free_row(row_count, false), lattice(dims);
+  for (std::size_t d = 0; d < dims; ++d) lattice[d] = noise_free(p.noise, d);
   for (std::size_t cell = 0; cell < p.states.size(); ++cell) {
     if (p.lower_roles[cell] != CellRole::Free && p.upper_roles[cell] != CellRole::Free) continue;
-    p.states.multi_index(cell, multi.data());
-    for (std::size_t u = 0; u < inputs; ++u) {
-      for (std::size_t w = 0; w < disturbances; ++w) {
-        p.mean_box(cell, u, w, lo.data(), hi.data());
-        std::vector<DimensionBounds>& row = rows[(cell * inputs + u) * disturbances + w];
-        for (std::size_t d = 0; d < dims; ++d) {
-          const auto k = std::int64_t(multi[d]);
-          const MassInterval scale = per_dimension[d].scale_range(p.states.face(d, k), p.states.face(d, k + 1));
-          row.push_back(per_dimension[d].dimension_bounds(p.states, lo[d], hi[d], scale.lo, scale.hi));
-        }
-      }
+    for (std::size_t r = cell * inputs * disturbances; r < (cell + 1) * inputs * disturbances; ++r) {
+      lo[r].assign(dims, 0.0);
+      hi[r].assign(dims, 0.0);
+      std::vector<double> expansion(dims, 0.0);
+      p.mean_box(cell, (r / disturbances) % inputs, r % disturbances, lo[r].data(), hi[r].data(), expansion.data());
+      free_row[r] = true;
+      for (std::size_t d = 0; d < dims; ++d)
+        lattice[d] = lattice[d] && lattice_row(p.states, d, lo[r][d], hi[r][d], expansion[d]);
+    }
+  }
+  std::vector<std::vector<DimensionBounds>> rows(row_count);
+  std::vector<std::size_t> multi(dims);
+  for (std::size_t r = 0; r < row_count; ++r) {
+    if (!free_row[r]) continue;
+    p.states.multi_index(r / (inputs * disturbances), multi.data());
+    for (std::size_t d = 0; d < dims; ++d) {
+      const auto k = std::int64_t(multi[d]);
+      const MassInterval scale = per_dimension[d].scale_range(p.states.face(d, k), p.states.face(d, k + 1));
+      rows[r].push_back(lattice[d] ? lattice_bounds(p.states, d, lo[r][d], hi[r][d])
+                                   : per_dimension[d].dimension_bounds(p.states, lo[r][d], hi[r][d], scale.lo, scale.hi));
     }
   }
   return rows;

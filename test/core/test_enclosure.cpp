@@ -277,7 +277,7 @@ TEST(Enclosure, RobustReferenceBoundsFromEnclosures) {
   const Grid none;
   const NoiseModel noise(test_support::normal_noise({0.15 * 0.15}), states);
   detail::RobustProblem problem{states, none, none, noise,
-                                [&](std::size_t cell, std::size_t, std::size_t, double* lo, double* hi) {
+                                [&](std::size_t cell, std::size_t, std::size_t, double* lo, double* hi, double*) {
                                   const double centre = states.coordinate(0, cell);
                                   *lo = round_down(0.8 * (centre - 0.05) + 0.1, 3);
                                   *hi = round_up(0.8 * (centre + 0.05) + 0.1, 3);
@@ -305,9 +305,9 @@ TEST(Enclosure, MeanBoxesAreTheEnclosuresOnABinaryGrid) {
   for (std::size_t i = 0; i + 1 < states.count(0); ++i)
     for (std::size_t j = 2; j < states.count(1); ++j) {
       const std::size_t cell = i * states.count(1) + j, neighbour = (i + 1) * states.count(1) + j - 2;
-      double lo[2], hi[2], other_lo[2], other_hi[2];
-      mean_box(cell, 0, 0, lo, hi);
-      mean_box(neighbour, 0, 0, other_lo, other_hi);
+      double lo[2], hi[2], other_lo[2], other_hi[2], expansion[2] = {0, 0};
+      mean_box(cell, 0, 0, lo, hi, expansion);
+      mean_box(neighbour, 0, 0, other_lo, other_hi, expansion);
       const std::vector<double> centre = states.point(cell);
       const ImageBox image = enclosure.enclose(
           {Interval(centre[0] - 0.05, centre[0] + 0.05), Interval(centre[1] - 0.05, centre[1] + 0.05)}, {}, {});

@@ -205,8 +205,8 @@ TEST(MassBounds, ZeroScaleIsAPointMass) {
   EXPECT_EQ(across.lo, 0.0);
   EXPECT_EQ(across.hi, 1.0);
   // A closed image as wide as the cell (a deterministic step of exactly one cell) reaches the next
-  // cell's lower face: the point may lie in either cell (docs/bmw_parking.md, "A certified final
-  // approach").
+  // cell's lower face: from the box alone the point may lie in either cell (a lattice dimension's
+  // rows argue on margins instead: bounds/lattice.hpp, test_lattice_bounds).
   const MassInterval whole = d.bounds.bounds(0.0, 0.2, 0.0, 0.2, 0.0, 0.0);
   EXPECT_EQ(whole.lo, 0.0);
   EXPECT_EQ(whole.hi, 1.0);

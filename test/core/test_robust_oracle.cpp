@@ -86,7 +86,7 @@ RobustValues robust_1d(const Grid& grid, const LinearSystem& system, const SpecC
                                            {system.inputs[1] - system.inputs[0]}));
   RobustProblem problem{grid, inputs, none, noise, nullptr, spec.type, spec.horizon,
                         robust_cell_roles(grid, spec, Bound::Lower), robust_cell_roles(grid, spec, Bound::Upper)};
-  problem.mean_box = [&](std::size_t cell, std::size_t u, std::size_t, double* lo, double* hi) {
+  problem.mean_box = [&](std::size_t cell, std::size_t u, std::size_t, double* lo, double* hi, double*) {
     const double centre = grid.coordinate(0, cell), half = 0.5 * grid.eta()[0];
     system.box(centre - half, centre + half, u, lo, hi);
   };
@@ -173,7 +173,7 @@ void compare_orthogonal_with_joint(const Grid& states, const Grid& inputs, const
   const Grid none;
   RobustProblem problem{states, inputs, none, noise, nullptr, spec.type, spec.horizon,
                         robust_cell_roles(states, spec, Bound::Lower), robust_cell_roles(states, spec, Bound::Upper)};
-  problem.mean_box = [&](std::size_t cell, std::size_t input, std::size_t, double* lo, double* hi) {
+  problem.mean_box = [&](std::size_t cell, std::size_t input, std::size_t, double* lo, double* hi, double*) {
     const std::vector<double> centre = states.point(cell), u = inputs.point(input);
     for (std::size_t i = 0; i < n; ++i) {
       double low = i == 0 && !u.empty() ? u[0] : 0.0, high = low;

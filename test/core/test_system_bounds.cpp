@@ -153,7 +153,7 @@ std::vector<Segment> segments_1d(const Grid& grid, const SpecConfig& spec) {
 
 // V_0 at every segment's nodes (value[s][j]) of x' = kSlope x + u + w + N(0, kSigma^2) under
 // `controller`: V = 1 on the target, 0 on the avoid set; V_T = 0 elsewhere; V_k(x) = min over the
-// disturbance grid of the integral over the covered set of N(y; kSlope x + u(k, cell of x) + w,
+// disturbance cells' points and faces (values of the covered set, the grid's points among them) of the integral over the covered set of N(y; kSlope x + u(k, cell of x) + w,
 // kSigma^2) V_{k+1}(y) dy (leaving it fails; the disturbance plays its worst, knowing x and u).
 // An empty `controller`: the best input of the grid at every node (the optimum over every
 // controller that plays inputs of the grid).
@@ -161,9 +161,17 @@ std::vector<std::vector<double>> continuous_value_1d(const std::vector<Segment>&
                                                      const std::vector<std::uint32_t>& controller) {
   const Grid& inputs = a.inputs;
   const std::size_t cells = a.states.size();
+  // The adversary plays the disturbances' covered set: each cell's point and faces.
   std::vector<double> disturbances;
-  for (std::size_t w = 0; w < a.disturbances.size(); ++w)
-    disturbances.push_back(a.disturbances.dims() ? a.disturbances.point(w)[0] : 0.0);
+  for (std::size_t w = 0; w < a.disturbances.size(); ++w) {
+    if (!a.disturbances.dims()) {
+      disturbances.push_back(0.0);
+      continue;
+    }
+    disturbances.push_back(a.disturbances.point(w)[0]);
+    if (w == 0) disturbances.push_back(a.disturbances.face(0, 0));
+    disturbances.push_back(a.disturbances.face(0, std::int64_t(w) + 1));
+  }
   std::vector<double> nodes, weights;  // all segments' nodes, with their Simpson weights
   std::vector<std::size_t> offset;
   for (const Segment& s : segments) {
@@ -293,8 +301,9 @@ TEST(SystemBounds, LinearGaussianBracketsTheServedControllersValueByQuadrature) 
 }
 
 TEST(SystemBounds, LinearGaussianWithADisturbanceBracketsByQuadrature) {
-  // The disturbance plays its worst against both the bounds and the continuous system.
-  expect_brackets_by_quadrature(from_yaml(linear_1d_yaml({0.43, 0.77}, {-0.52, -0.28}, "", 0.03)));
+  // The disturbance plays its worst against both the bounds and the continuous system: its grid
+  // {-0.015, 0.015} covers [-0.03, 0.03].
+  expect_brackets_by_quadrature(from_yaml(linear_1d_yaml({0.43, 0.77}, {-0.52, -0.28}, "", 0.015)));
 }
 
 TEST(SystemBounds, LinearGaussianWithTruncatedWindowsBracketsByQuadrature) {
@@ -477,8 +486,8 @@ TEST(SystemBounds, AlignedSetsCheckFindsAMeanBoxOffTheImage) {
   const ImageEnclosure enclosure(a.config);
   const MeanBox image = enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances);
   const double eta = a.states.eta()[0];
-  const MeanBox moved = [&](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi) {
-    image(cell, u, w, lo, hi);
+  const MeanBox moved = [&](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi, double* expansion) {
+    image(cell, u, w, lo, hi, expansion);
     *lo += eta;
     *hi += eta;
   };
@@ -497,7 +506,7 @@ constexpr double kOutwardRounding = 1e-10;
 
 void expect_point_boxes_reproduce_the_abstraction(const std::string& yaml) {
   const Abstraction a = from_yaml(yaml);
-  const MeanBox point = [&a](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi) {
+  const MeanBox point = [&a](std::size_t cell, std::size_t u, std::size_t w, double* lo, double* hi, double*) {
     const std::vector<double> x = a.states.point(cell), input = a.inputs.point(u), d = a.disturbances.point(w);
     a.dynamics->evaluate(x.data(), input.data(), d.data(), lo);
     std::copy(lo, lo + a.states.dims(), hi);

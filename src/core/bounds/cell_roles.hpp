@@ -13,9 +13,11 @@
 namespace amytiss::detail {
 
 /// Writes lo[i] <= f(x, u, w)_i <= hi[i] (state units) for every x in state cell `cell` (flat
-/// index), input index `input` and disturbance index `disturbance`.
+/// index), input index `input` and disturbance index `disturbance`; and, where it knows one,
+/// expansion[i]: a lower bound of |df_i/dx_i| over the cell (ImageBox::expansion). The caller fills
+/// `expansion` with 0 (nothing known) before the call.
 using MeanBox = std::function<void(std::size_t cell, std::size_t input, std::size_t disturbance, double* lo,
-                                   double* hi)>;
+                                   double* hi, double* expansion)>;
 
 /// Cell roles for one bound, from the cells' interiors (c - eta/2, c + eta/2): the bounds hold for
 /// every x inside a cell; contact with a set along a face (within kFaceTolerance * eta) does not

@@ -13,9 +13,10 @@
 namespace amytiss::detail {
 namespace {
 
-// Bytes of one distinct key in a worker's tables: the key (four doubles) in the list and in the
-// hash map's node (with its index, the next pointer and the cached hash) and a bucket.
-constexpr double kKeyBytes = 32 + 56 + 8;
+// Bytes of one distinct key in a worker's tables: the key (five doubles) in the list and in the
+// hash map's node (with its index, the next pointer, the cached hash and malloc's header) and a
+// bucket.
+constexpr double kKeyBytes = 40 + 80 + 8;
 // Each worker's keys are merged into one table: as many again, and an index per key.
 constexpr double kMergeFactor = 2;
 // Bytes of one suffix class in its hash map: the node (key, index, next pointer, malloc's header)

@@ -1,11 +1,12 @@
 #include "bounds/row_bounds.hpp"
 
 #include <algorithm>
-#include <cstring>
 #include <atomic>
+#include <cstring>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "bounds/lattice.hpp"
 #include "common/parallel_for.hpp"
 
 namespace amytiss::detail {
@@ -33,7 +34,7 @@ struct BoundsKeyEqual {
 };
 struct BoundsKeyHash {
   std::size_t operator()(const BoundsKey& key) const {
-    std::uint64_t words[4];
+    std::uint64_t words[5];
     std::memcpy(words, &key, sizeof words);
     std::uint64_t hash = 0x9e3779b97f4a7c15ull;
     for (std::uint64_t word : words) hash = (hash ^ word) * 0x100000001b3ull + (hash >> 29);
@@ -50,9 +51,9 @@ struct WorkerTables {
 }  // namespace
 
 RowBounds::BoundsKey bounds_key(const Grid& states, const MassBounds& mass, std::size_t d, std::size_t k, double lo,
-                                double hi) {
+                                double hi, double expansion) {
   const MassInterval scale = mass.scale_range(states.face(d, std::int64_t(k)), states.face(d, std::int64_t(k) + 1));
-  return {lo, hi, scale.lo, scale.hi};
+  return {lo, hi, scale.lo, scale.hi, expansion};
 }
 
 std::optional<std::vector<std::size_t>> count_distinct_bounds(const Abstraction& a, const MeanBox& mean_box,
@@ -71,18 +72,20 @@ std::optional<std::vector<std::size_t>> count_distinct_bounds(const Abstraction&
     const MassBounds mass(*a.noise, d);
     using KeySet = std::unordered_set<BoundsKey, BoundsKeyHash, BoundsKeyEqual>;
     const unsigned workers = unsigned(std::max<std::size_t>(1, std::min<std::size_t>(threads, tuples)));
+    const bool lattice_candidate = noise_free(*a.noise, d);
     std::vector<KeySet> sets(workers);
     std::atomic<bool> too_many{false};
     parallel_for(tuples, workers, [&](unsigned worker, std::size_t first, std::size_t last) {
-      std::vector<double> lo(dims), hi(dims);
+      std::vector<double> lo(dims), hi(dims), expansion(dims);
       std::vector<std::size_t> multi(dims, 0);
       for (std::size_t tuple = first; tuple < last && !too_many; ++tuple) {
         for (std::size_t rest = tuple, j = read.size(); j-- > 0; rest /= a.states.count(read[j]))
           multi[read[j]] = rest % a.states.count(read[j]);
         const std::size_t cell = a.states.flat_index(multi.data());
         for (std::size_t r = 0; r < rows_per_cell; ++r) {
-          mean_box(cell, r / a.disturbances.size(), r % a.disturbances.size(), lo.data(), hi.data());
-          sets[worker].insert(bounds_key(a.states, mass, d, multi[d], lo[d], hi[d]));
+          mean_box(cell, r / a.disturbances.size(), r % a.disturbances.size(), lo.data(), hi.data(), expansion.data());
+          sets[worker].insert(
+              bounds_key(a.states, mass, d, multi[d], lo[d], hi[d], lattice_candidate ? expansion[d] : 0.0));
         }
         if (sets[worker].size() > max_keys) too_many = true;
       }
@@ -144,7 +147,7 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
     table.keys.resize(dims_);
     table.index.resize(dims_);
     SharedBounds shared(states, rows_per_cell, reads);
-    std::vector<double> lo(dims_), hi(dims_);
+    std::vector<double> lo(dims_), hi(dims_), expansion(dims_);
     std::vector<std::size_t> multi(dims_);
     std::vector<std::uint32_t*> slots(dims_);
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
@@ -161,10 +164,12 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
             known = false;
         }
         if (known) continue;
-        mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data());
+        std::fill(expansion.begin(), expansion.end(), 0.0);
+        mean_box(cell, (r / disturbances_) % inputs_, r % disturbances_, lo.data(), hi.data(), expansion.data());
         for (std::size_t d = 0; d < dims_; ++d) {
           if (slots[d] && *slots[d] != SharedBounds::kUnknown) continue;
-          const BoundsKey key = bounds_key(states, per_dimension[d], d, multi[d], lo[d], hi[d]);
+          const BoundsKey key =
+              bounds_key(states, per_dimension[d], d, multi[d], lo[d], hi[d], noise_free(noise, d) ? expansion[d] : 0.0);
           const auto found = table.index[d].emplace(key, std::uint32_t(table.keys[d].size()));
           index_[r * dims_ + d] = found.first->second;
           if (slots[d]) *slots[d] = found.first->second;
@@ -187,6 +192,12 @@ RowBounds::RowBounds(const Grid& states, const Grid& inputs, const Grid& disturb
       }
     }
   }
+  lattice_.assign(dims_, false);
+  for (std::size_t d = 0; d < dims_; ++d) {
+    lattice_[d] = noise_free(noise, d);
+    for (const BoundsKey& key : keys[d])
+      lattice_[d] = lattice_[d] && lattice_row(states, d, key.m_lo, key.m_hi, key.expansion);
+  }
   compute_bounds(states, per_dimension, keys, threads);
   parallel_for(cells, threads, [&](unsigned worker, std::size_t first_cell, std::size_t last_cell) {
     for (std::size_t cell = first_cell; cell < last_cell; ++cell) {
@@ -205,8 +216,9 @@ void RowBounds::compute_bounds(const Grid& states, const std::vector<MassBounds>
     bounds[d].resize(keys[d].size());
     parallel_for(keys[d].size(), threads, [&](unsigned, std::size_t first, std::size_t last) {
       for (std::size_t i = first; i < last; ++i)
-        bounds[d][i] = per_dimension[d].dimension_bounds(states, keys[d][i].m_lo, keys[d][i].m_hi, keys[d][i].s_lo,
-                                                         keys[d][i].s_hi);
+        bounds[d][i] = lattice_[d] ? lattice_bounds(states, d, keys[d][i].m_lo, keys[d][i].m_hi)
+                                   : per_dimension[d].dimension_bounds(states, keys[d][i].m_lo, keys[d][i].m_hi,
+                                                                       keys[d][i].s_lo, keys[d][i].s_hi);
     });
     for (const DimensionBounds& one : bounds[d]) pool_size_ += one.cells.size();
   }

@@ -57,9 +57,14 @@ class RowBounds {
   std::size_t intervals() const { return pool_size_; }
   std::size_t bytes() const;
 
- /// What determines one dimension's bounds: the mean interval and the noise's scale range.
+  /// Whether dimension d is a lattice dimension (bounds/lattice.hpp): noise-free, and every row
+  /// sends its cell into one cell; its rows then have the point mass [1, 1] on that cell.
+  bool lattice(std::size_t d) const { return lattice_[d]; }
+
+  /// What determines one dimension's bounds: the mean interval, the noise's scale range and, for a
+  /// noise-free dimension, the expansion of the map along it (0 for the others).
   struct BoundsKey {
-    double m_lo, m_hi, s_lo, s_hi;
+    double m_lo, m_hi, s_lo, s_hi, expansion;
   };
 
  private:
@@ -76,13 +81,15 @@ class RowBounds {
   std::vector<std::vector<SuffixParts>> suffix_parts_;  // per dimension, per class
   void number_suffix_classes(const std::vector<bool>& needed);
   std::vector<MassInterval> pool_;  // the views point into it
+  std::vector<bool> lattice_;       // per dimension
   std::size_t pool_size_ = 0;
 };
 
 /// The key of dimension d's bounds of a row whose mean interval along d is [lo, hi] (state units),
-/// in a cell of index k along d.
+/// in a cell of index k along d; `expansion`: the map's least expansion along d (0 where the
+/// dimension is noisy, so that it does not split keys).
 RowBounds::BoundsKey bounds_key(const Grid& states, const MassBounds& mass, std::size_t d, std::size_t k, double lo,
-                                double hi);
+                                double hi, double expansion);
 /// Per dimension, how many distinct bounds the rows of every cell have (what RowBounds stores
 /// when every cell is needed; at least what it stores for some), from the mean boxes of one cell
 /// per combination of the coordinates the dimension reads, on `threads` workers; nothing once a

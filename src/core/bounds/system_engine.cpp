@@ -4,6 +4,7 @@
 
 #include "amytiss/enclosure.hpp"
 #include "amytiss/format.hpp"
+#include "bounds/lattice.hpp"
 #include "bounds/mean_box.hpp"
 #include "bounds/method.hpp"
 #include "bounds/robust_iteration.hpp"
@@ -33,6 +34,8 @@ Policy run_system_bounds(const Abstraction& a, BoundsMethod method, bool serial,
   const RowBounds rows(a.states, a.inputs, a.disturbances, *a.noise,
                        enclosure_mean_box(enclosure, a.states, a.inputs, a.disturbances), needed, threads,
                        bounds_reads(a));
+  const std::string lattice = lattice_text(*a.noise, rows);
+  if (!lattice.empty()) reporter.report().notes.push_back({NoteSeverity::Info, NoteKind::Transitions, lattice});
   const double construction_seconds = seconds_since(construction_start);
   reporter.phase(PhaseKind::Construction, "interval bounds", construction_seconds,
                  double(a.pairs()) / std::max(construction_seconds, 1e-9));
@@ -91,6 +94,24 @@ std::string no_cell_reason(const Grid& states, const SpecConfig& spec, CellRole 
 }
 
 }  // namespace
+
+std::string lattice_text(const NoiseModel& noise, const RowBounds& rows) {
+  std::string on, off;
+  for (std::size_t d = 0; d < noise.dims(); ++d) {
+    if (!noise_free(noise, d)) continue;
+    std::string& list = rows.lattice(d) ? on : off;
+    list += (list.empty() ? "" : ", ") + std::to_string(d);
+  }
+  std::string text;
+  if (!on.empty())
+    text = "noise-free state dimension(s) " + on +
+           " move on the cells' lattice: point masses [1, 1] on the cell each row sends them to (the bounds hold "
+           "for states more than n * 2^-36 eta inside their cells along them, n the steps behind the value)";
+  if (!off.empty())
+    text += (text.empty() ? "" : "; ") + std::string("noise-free state dimension(s) ") + off +
+            " leave a cell's image over more than one cell somewhere: mass [0, 1] on each cell a mean box touches";
+  return text;
+}
 
 RolesText lower_roles_text(const Grid& states, const SpecConfig& spec, const std::vector<CellRole>& lower_roles) {
   const bool safety = spec.type == SpecType::Safety;

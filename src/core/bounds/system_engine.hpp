@@ -9,6 +9,7 @@
 #include "amytiss/policy.hpp"
 #include "solve/backward_driver.hpp"
 #include "bounds/cell_roles.hpp"
+#include "bounds/row_bounds.hpp"
 
 namespace amytiss::detail {
 
@@ -30,5 +31,9 @@ struct RolesText {
   bool warning = false;
 };
 RolesText lower_roles_text(const Grid& states, const SpecConfig& spec, const std::vector<CellRole>& lower_roles);
+
+/// Which noise-free state dimensions of `rows` are lattice dimensions (RowBounds::lattice()) and
+/// which are not, as a note; empty without noise-free dimensions.
+std::string lattice_text(const NoiseModel& noise, const RowBounds& rows);
 
 }  // namespace amytiss::detail

@@ -1,5 +1,7 @@
 #include "amytiss/enclosure.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "amytiss/expression.hpp"
@@ -64,7 +66,7 @@ struct ImageEnclosure::Map {
     return state;
   }
 
-  void check(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  void check(const IntervalBox& cell, const std::vector<double>& u, const IntervalBox& w) const {
     if (cell.size() != state_dims || u.size() != input_dims || w.size() != disturbance_dims)
       throw std::logic_error("ImageEnclosure: expected a cell of " + std::to_string(state_dims) + " states, " +
                              std::to_string(input_dims) + " inputs and " + std::to_string(disturbance_dims) +
@@ -76,15 +78,22 @@ struct ImageEnclosure::Map {
     for (double value : values) jets.push_back(IntervalJet::constant(Interval::point(value), dims));
     return jets;
   }
+  // The disturbance enters like an input that ranges over an interval: no gradient (the
+  // enclosures' derivatives are in x only).
+  Jets ranges(const IntervalBox& values, std::size_t dims) const {
+    Jets jets;
+    for (const Interval& value : values) jets.push_back(IntervalJet::constant(value, dims));
+    return jets;
+  }
 
-  // f over the cell; with gradients (dims = state_dims) or without (dims = 0).
-  Jets over(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w, bool gradients) const {
+  // f over the cell and the disturbances' box; with gradients (dims = state_dims) or without (dims = 0).
+  Jets over(const IntervalBox& cell, const std::vector<double>& u, const IntervalBox& w, bool gradients) const {
     check(cell, u, w);
     const std::size_t dims = gradients ? state_dims : 0;
     Jets x;
     for (std::size_t j = 0; j < cell.size(); ++j)
       x.push_back(gradients ? IntervalJet::variable(cell[j], j, dims) : IntervalJet::constant(cell[j], 0));
-    return step(x, points(u, dims), points(w, dims), dims);
+    return step(x, points(u, dims), ranges(w, dims), dims);
   }
 };
 
@@ -133,29 +142,53 @@ std::size_t ImageEnclosure::state_dims() const { return map_->state_dims; }
 std::size_t ImageEnclosure::input_dims() const { return map_->input_dims; }
 std::size_t ImageEnclosure::disturbance_dims() const { return map_->disturbance_dims; }
 
+namespace {
+IntervalBox point_box(const std::vector<double>& values) {
+  IntervalBox box;
+  for (double value : values) box.push_back(Interval::point(value));
+  return box;
+}
+}  // namespace
+
 ImageBox ImageEnclosure::natural(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  return natural_over(cell, u, point_box(w));
+}
+
+ImageBox ImageEnclosure::natural_over(const IntervalBox& cell, const std::vector<double>& u,
+                                      const IntervalBox& w) const {
   return image_of(map_->over(cell, u, w, false));
 }
 
 IntervalJacobian ImageEnclosure::jacobian(const IntervalBox& cell, const std::vector<double>& u,
                                           const std::vector<double>& w) const {
   IntervalJacobian jacobian;
-  for (const IntervalJet& jet : map_->over(cell, u, w, true)) {
+  for (const IntervalJet& jet : map_->over(cell, u, point_box(w), true)) {
     jacobian.entries.push_back(jet.gradient);
     jacobian.valid.push_back(jet.smooth);
   }
   return jacobian;
 }
 
-// Mean-value theorem (Lebourg's for the Lipschitz |.|, min, max): f_i(x) - f_i(c) lies in
-// sum_j J_ij(X) (x_j - c_j) for x in X, so f_i(X) lies in f_i(c) + sum_j J_ij(X) (X_j - c_j).
 ImageBox ImageEnclosure::enclose(const IntervalBox& cell, const std::vector<double>& u, const std::vector<double>& w) const {
+  return enclose_over(cell, u, point_box(w));
+}
+
+// Mean-value theorem (Lebourg's for the Lipschitz |.|, min, max), at each fixed w of W: f_i(x, w) -
+// f_i(c, w) lies in sum_j J_ij(X, W) (x_j - c_j) for x in X, so f_i(X, W) lies in
+// f_i(c, W) + sum_j J_ij(X, W) (X_j - c_j).
+ImageBox ImageEnclosure::enclose_over(const IntervalBox& cell, const std::vector<double>& u,
+                                      const IntervalBox& w) const {
   const Jets jets = map_->over(cell, u, w, true);
   IntervalBox centre_box;
   for (const Interval& component : cell) centre_box.push_back(Interval::point(component.mid()));
   const Jets at_centre = map_->over(centre_box, u, w, false);
   ImageBox image = image_of(jets);
   for (std::size_t i = 0; i < jets.size(); ++i) {
+    // Lebourg's theorem along x_i: f_i(x + d e_i) - f_i(x) lies in J_ii(X) d, so a J_ii of one
+    // sign moves f_i by at least its least magnitude times |d|.
+    const Interval& own = jets[i].gradient[i];
+    const bool one_sign = jets[i].smooth && !own.is_empty() && !own.contains_zero();
+    image.expansion.push_back(one_sign ? std::min(std::fabs(own.lo), std::fabs(own.hi)) : 0.0);
     if (!jets[i].smooth || !at_centre[i].value.defined) continue;
     Interval centred = at_centre[i].value;
     for (std::size_t j = 0; j < cell.size(); ++j) centred = centred + jets[i].gradient[j] * (cell[j] - centre_box[j]);
