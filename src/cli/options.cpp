@@ -114,8 +114,8 @@ void check_export_alone(const Options& options) {
     if (given)
       throw UsageError(std::string("--export: got it with ") + name +
                        ", expected --export without the options of a synthesis (--dry-run, --at, --simulate, "
-                       "--output, --profile, --compare-reference): an export writes the abstraction and computes no policy "
-                       "(example: --config c.yaml --export prism out/)");
+                       "--output, --profile, --compare-reference): an export writes the abstraction and computes no "
+                       "policy (example: --config c.yaml --export prism out/)");
 }
 
 }  // namespace
