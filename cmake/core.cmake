@@ -32,7 +32,8 @@ set_target_properties(amytiss_core PROPERTIES POSITION_INDEPENDENT_CODE ON)
 # (docs/scale_out.md). The core does not link MPI; the CLI passes it a Communicator.
 find_package(MPI COMPONENTS C QUIET)
 if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/cli/amytiss_synth.cpp)
-  add_executable(amytiss_synth src/cli/amytiss_synth.cpp src/cli/mpi_session.cpp src/cli/options.cpp src/cli/printing.cpp)
+  add_executable(amytiss_synth src/cli/amytiss_synth.cpp src/cli/mpi_session.cpp src/cli/options.cpp src/cli/printing.cpp
+    src/cli/simulation.cpp)
   target_link_libraries(amytiss_synth amytiss_core)
   if(MPI_C_FOUND)
     # OMPI_SKIP_MPICXX: the C API only (the deprecated C++ bindings need libmpi_cxx).

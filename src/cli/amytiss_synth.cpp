@@ -16,6 +16,7 @@
 #include "mpi_session.hpp"
 #include "options.hpp"
 #include "printing.hpp"
+#include "simulation.hpp"
 
 namespace {
 
@@ -129,6 +130,7 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   if (options.profile) print_profile(report);
   print_value_summary(policy);
   if (!options.at.empty()) print_values_at(policy, options.at);
+  if (options.simulate && mpi.rank() == 0) print_simulation(config, policy, options.at, options.simulate, options.seed);
   if (mpi.rank() == 0) print_apriori_error(abstraction);
   if (options.compare_reference) {
     const double engine_compute_seconds = report.phases.empty() ? synthesis_wall_seconds : compute_seconds(report);

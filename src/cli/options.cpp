@@ -1,10 +1,15 @@
 #include "options.hpp"
 
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <sstream>
 #include <utility>
 #include <vector>
+
+#include "amytiss/closed_loop.hpp"
 
 namespace amytiss::cli {
 
@@ -26,6 +31,9 @@ const char* const kUsage =
     "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
     "  --guarantee abstraction|system     overrides guarantee (system: bounds for the continuous system)\n"
     "  --at X0,X1,...                     print the policy's values at this state (step 0) and its input\n"
+    "  --simulate N                       with --at: N episodes of the continuous closed loop from uniform\n"
+    "                                     points of that state's cell; prints the success rate beside the values\n"
+    "  --seed S                           seed of --simulate (default 1; the same seed, the same rate)\n"
     "  --dry-run                          print the plan (engine, devices, sweep, work split), compute nothing\n"
     "  --output FILE                      policy file to write (default: <name>.h5 here)\n"
     "  --profile                          per-phase timing, rates and memory table\n"
@@ -64,20 +72,50 @@ std::vector<double> parse_state(const std::string& text) {
   return state;
 }
 
+// A whole number in [minimum, maximum] for `option`; UsageError naming the option, the text and
+// `example` otherwise.
+std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t minimum,
+                          std::uint64_t maximum, const std::string& example) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long value = std::strtoull(text.c_str(), &end, 10);
+  const bool whole = !text.empty() && std::isdigit(static_cast<unsigned char>(text[0])) && *end == '\0' && errno == 0;
+  if (!whole || value < minimum || value > maximum)
+    throw UsageError(option + ": got '" + text + "', expected a whole number from " + std::to_string(minimum) +
+                     " to " + std::to_string(maximum) + " (example: " + option + " " + example + ")");
+  return value;
+}
+
+// --simulate runs from --at's cell after a synthesis; --seed only seeds it.
+void check_simulation(const Options& options) {
+  if (options.simulate && options.at.empty())
+    throw UsageError("--simulate: got " + std::to_string(options.simulate) +
+                     " episodes without --at, expected the state whose cell the episodes start from (example: "
+                     "--at -8,-8 --simulate 1000)");
+  if (options.simulate && options.dry_run)
+    throw UsageError("--simulate: got it with --dry-run, expected a synthesis to simulate: a dry run computes no "
+                     "policy (example: --at -8,-8 --simulate 1000)");
+  if (options.seed_given && !options.simulate)
+    throw UsageError("--seed: got " + std::to_string(options.seed) +
+                     " without --simulate, expected it with the episodes it seeds (example: --at -8,-8 --simulate "
+                     "1000 --seed 7)");
+}
+
 // An export writes the abstraction and exits: the options of a synthesis would be ignored.
 void check_export_alone(const Options& options) {
   if (options.export_format.empty()) return;
   const std::pair<bool, const char*> synthesis_options[] = {{options.dry_run, "--dry-run"},
                                                             {!options.at.empty(), "--at"},
+                                                            {options.simulate > 0, "--simulate"},
                                                             {!options.output.empty(), "--output"},
                                                             {options.profile, "--profile"},
                                                             {options.compare_reference, "--compare-reference"}};
   for (const auto& [given, name] : synthesis_options)
     if (given)
       throw UsageError(std::string("--export: got it with ") + name +
-                       ", expected --export without the options of a synthesis (--dry-run, --at, --output, "
-                       "--profile, --compare-reference): an export writes the abstraction and computes no policy "
-                       "(example: --config c.yaml --export prism out/)");
+                       ", expected --export without the options of a synthesis (--dry-run, --at, --simulate, "
+                       "--output, --profile, --compare-reference): an export writes the abstraction and computes no "
+                       "policy (example: --config c.yaml --export prism out/)");
 }
 
 }  // namespace
@@ -100,7 +138,12 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--devices") options.devices = value();
     else if (arg == "--guarantee") options.guarantee = value();
     else if (arg == "--at") options.at = parse_state(value());
-    else if (arg == "--dry-run") options.dry_run = true;
+    else if (arg == "--simulate")
+      options.simulate = parse_count("--simulate", value(), 1, kMaxSimulatedEpisodes, "1000");
+    else if (arg == "--seed") {
+      options.seed = parse_count("--seed", value(), 0, UINT64_MAX, "7");
+      options.seed_given = true;
+    } else if (arg == "--dry-run") options.dry_run = true;
     else if (arg == "--output" || arg == "-o") options.output = value();
     else if (arg == "--export") {
       options.export_format = value();
@@ -124,6 +167,7 @@ Options parse_options(int argc, char** argv) {
     else throw UsageError("unknown option '" + arg + "' (see --help)");
   }
   check_export_alone(options);
+  check_simulation(options);
   if (!options.help && !options.list_devices && options.config_path.empty())
     throw UsageError("--config FILE is required (example: --config config/robot_safety.yaml)");
   return options;

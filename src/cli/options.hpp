@@ -1,6 +1,7 @@
 #pragma once
 // amytiss_synth's command line: its options, their parsing and the usage text.
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +17,9 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The seed of --simulate when --seed is not given.
+constexpr std::uint64_t kDefaultSimulationSeed = 1;
+
 struct Options {
   std::string config_path;
   std::string device;       // empty: the configuration's
@@ -26,6 +30,9 @@ struct Options {
   std::string devices;      // empty: the configuration's
   std::string guarantee;    // empty: the configuration's
   std::vector<double> at;   // a state whose values to print after the synthesis; empty: none
+  std::size_t simulate = 0;   // episodes of the closed loop from --at's cell; 0: none
+  std::uint64_t seed = kDefaultSimulationSeed;  // of --simulate
+  bool seed_given = false;
   std::string output;
   std::string export_format;  // empty: no export
   std::string export_directory;
@@ -38,7 +45,8 @@ struct Options {
   bool help = false;
 };
 
-/// The options of argv; UsageError for an unknown option, a missing value or a missing --config.
+/// The options of argv; UsageError for an unknown option, a missing value, a missing --config, or
+/// --simulate without --at, with a count of 0 or above kMaxSimulatedEpisodes (closed_loop.hpp).
 Options parse_options(int argc, char** argv);
 
 }  // namespace amytiss::cli

@@ -8,29 +8,10 @@
 namespace amytiss_ros {
 
 PlantModel::PlantModel(const amytiss::Config& config, std::uint64_t seed)
-    : config_(config),
-      dynamics_(amytiss::make_dynamics(config)),
-      state_dims_(config.states.lb.size()),
-      noise_(config.noise, state_dims_, config.constants),
-      random_(seed) {}
+    : plant_(config, amytiss::DisturbanceDraw::Box), random_(seed) {}
 
 std::vector<double> PlantModel::step(const std::vector<double>& state, const std::vector<double>& input) {
-  std::vector<double> disturbance;
-  if (config_.disturbances) {
-    for (std::size_t i = 0; i < config_.disturbances->lb.size(); ++i)
-      disturbance.push_back(
-          std::uniform_real_distribution<double>(config_.disturbances->lb[i], config_.disturbances->ub[i])(random_));
-  }
-  std::vector<double> next(state_dims_);
-  dynamics_->evaluate(state.data(), input.empty() ? nullptr : input.data(),
-                      disturbance.empty() ? nullptr : disturbance.data(), next.data());
-  const std::vector<double> noise = draw_noise(state);
-  for (std::size_t i = 0; i < state_dims_; ++i) next[i] += noise[i];
-  return next;
-}
-
-std::vector<double> PlantModel::draw_noise(const std::vector<double>& state) {
-  return noise_.draw(state.data(), random_);
+  return plant_.step(state, input, random_);
 }
 
 StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state) {

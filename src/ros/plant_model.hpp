@@ -1,12 +1,10 @@
 #pragma once
-// A concrete stochastic plant for closed-loop simulation: x+ = f(x, u, w) + noise (additive) or
-// f(x, u, w) + noise * |x| (multiplicative, per component), with its own seeded random numbers.
-// The noise is drawn from the configuration's noise description in one place, draw_noise(), by
-// amytiss::NoiseSampler: every law the synthesizer accepts.
-// The disturbance w, when the configuration has one, is drawn uniformly from its box each step
-// (the synthesis assumed the worst case, so a random one can only do better).
+// The plant simulator node's plant and the texts of its episodes. The plant is the core's
+// amytiss::Plant (x+ = f(x, u, w) + noise, noise by amytiss::NoiseSampler, docs/semantics.md)
+// with its own seeded random numbers; the disturbance w, when the configuration has one, is drawn
+// uniformly from its box each step (the synthesis assumed the worst case, so a random one can only
+// do better).
 #include <cstdint>
-#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -14,7 +12,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/model.hpp"
-#include "amytiss/noise_sampler.hpp"
+#include "amytiss/plant.hpp"
 #include "amytiss/policy.hpp"
 
 namespace amytiss_ros {
@@ -25,19 +23,12 @@ class PlantModel {
   /// make_dynamics.
   PlantModel(const amytiss::Config& config, std::uint64_t seed);
 
-  std::size_t state_dims() const { return state_dims_; }
+  std::size_t state_dims() const { return plant_.state_dims(); }
   /// One step from `state` under `input` (input dims of the configuration, empty if none).
   std::vector<double> step(const std::vector<double>& state, const std::vector<double>& input);
 
  private:
-  /// One draw of the noise added to f(x, u, w) at `state` (state units; multiplicative noise
-  /// already scaled by |x|).
-  std::vector<double> draw_noise(const std::vector<double>& state);
-
-  amytiss::Config config_;
-  std::unique_ptr<amytiss::Dynamics> dynamics_;
-  std::size_t state_dims_ = 0;
-  amytiss::NoiseSampler noise_;
+  amytiss::Plant plant_;
   std::mt19937_64 random_;
 };
 

@@ -52,7 +52,7 @@ TEST(Layout, CoreHeadersSourcesAndCliIncludeNoRos) {
 int layer_of(const std::string& folder) {
   static const std::vector<std::pair<std::string, int>> kLayers = {
       {"common", 0},  {"model", 1}, {"config", 2}, {"factored", 3}, {"solve", 3},     {"serial", 4},
-      {"bounds", 4},  {"io", 4},    {"opencl", 5}, {"scale_out", 6}, {"", 7}};  // "": src/core itself (plan, engine)
+      {"bounds", 4},  {"io", 4},    {"simulate", 4}, {"opencl", 5}, {"scale_out", 6}, {"", 7}};  // "": src/core itself (plan, engine)
   for (const auto& [name, layer] : kLayers)
     if (folder == name) return layer;
   return -1;
@@ -64,7 +64,8 @@ int layer_of(const std::string& folder) {
 // declares config/'s reading and checks, which the layers below config/ do not call.
 const std::map<std::string, std::string>& public_header_folders() {
   static const std::map<std::string, std::string> folders = {
-      {"abstraction.hpp", "model"}, {"apriori_error.hpp", "model"},  {"config.hpp", "common"},
+      {"abstraction.hpp", "model"}, {"apriori_error.hpp", "model"},  {"closed_loop.hpp", "simulate"},
+      {"config.hpp", "common"},     {"plant.hpp", "simulate"},        {"spec_sets.hpp", "simulate"},
       {"enclosure.hpp", "model"},   {"engine.hpp", ""},               {"enum_names.hpp", "common"},
       {"errors.hpp", "common"},     {"expression.hpp", "model"},      {"expression_step.hpp", "model"},
       {"footprint.hpp", "model"},   {"format.hpp", "common"},         {"grid.hpp", "model"},

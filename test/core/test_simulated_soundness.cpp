@@ -1,0 +1,66 @@
+// The continuous-system bounds (guarantee: system) of shipped examples against the Monte Carlo
+// truth of the served controller (closed_loop.hpp): at each example's documented start, the
+// certified lower bound must not exceed the simulated success rate by more than 4 standard errors,
+// nor (without disturbances, where the upper bound holds for random disturbances too) the rate the
+// upper bound. The examples are those whose bounds take a few seconds at most on 2 cores.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "amytiss/abstraction.hpp"
+#include "amytiss/closed_loop.hpp"
+#include "amytiss/config.hpp"
+#include "amytiss/engine.hpp"
+#include "amytiss/policy.hpp"
+
+namespace amytiss {
+namespace {
+
+const std::string kConfigDir = std::string(AMYTISS_SOURCE_DIR) + "/config/";
+constexpr std::size_t kEpisodes = 300;
+constexpr double kStandardErrors = 4.0;
+constexpr std::uint64_t kSeed = 1;
+
+struct Example {
+  std::string config;
+  std::vector<double> start;  // documented in the configuration or its launch file
+};
+
+void expect_bounds_hold_the_rate(const Example& example) {
+  ComputeOverrides overrides;
+  overrides.guarantee = "system";
+  const Config config = load_config_file(kConfigDir + example.config, overrides);
+  const Abstraction abstraction = Abstraction::from_config(config);
+  SynthesisOptions options;
+  options.compute = config.compute;
+  const Policy policy = synthesize(abstraction, options, nullptr);
+  const auto cell = policy.states.cell_of(example.start.data());
+  ASSERT_TRUE(cell.has_value()) << example.config;
+  const double lower = policy.value(0, *cell), upper = policy.upper_value(0, *cell);
+  const SimulationResult result = simulate_cell(ClosedLoop(config, policy), *cell, kEpisodes, kSeed);
+  const std::string where = example.config + ": lower " + std::to_string(lower) + ", upper " +
+                            std::to_string(upper) + ", rate " + std::to_string(result.rate()) + " +- " +
+                            std::to_string(result.standard_error());
+  EXPECT_TRUE(result.consistent_with_lower(lower, kStandardErrors)) << where;
+  if (!config.disturbances) {
+    EXPECT_TRUE(result.consistent_with_upper(upper, kStandardErrors)) << where;
+  }
+  EXPECT_LE(lower, upper) << where;
+  ::testing::Test::RecordProperty(example.config, where);
+}
+
+TEST(SimulatedSoundness, RobotReachAvoidFromItsLaunchStart) {
+  expect_bounds_hold_the_rate({"robot_reach_avoid.yaml", {-8.0, -8.0}});
+}
+
+TEST(SimulatedSoundness, RobotSafetyFromItsLaunchStart) {
+  expect_bounds_hold_the_rate({"robot_safety.yaml", {0.0, 0.0}});
+}
+
+TEST(SimulatedSoundness, BmwFinalApproachFromItsDocumentedStart) {
+  expect_bounds_hold_the_rate({"bmw_final_approach.yaml", {0.25, 0.5, 1.4660765716752369}});
+}
+
+}  // namespace
+}  // namespace amytiss
