@@ -245,7 +245,7 @@ std::string opencl_program_source(const Abstraction& a, bool on_the_fly, std::si
   const Layout layout(a);
   return opencl_prelude(a, layout, on_the_fly, group_size) + contraction_source(layout, "contract_global", "__global") +
          contraction_source(layout, "contract_private", "") + a.dynamics->opencl_source() + "\n" +
-         embedded_source("engine.cl");
+         (a.states.all_uniform() ? std::string() : embedded_source("faced_states.cl")) + embedded_source("engine.cl");
 }
 
 }  // namespace amytiss::detail

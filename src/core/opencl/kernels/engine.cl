@@ -20,7 +20,8 @@
 //   Only for a state grid with faces, FACED_STATES defined and: STATE_FACED, FACE_START,
 //   POINT_START (int per dimension), STATE_FACES, STATE_POINTS (double, the faced dimensions'
 //   count + 1 faces and count points one after the other), KEEP_RADIUS (double per dimension:
-//   NoiseModel::window_radius). A faced dimension keeps the cells meeting [mean -+ KEEP_RADIUS].
+//   NoiseModel::window_radius). A faced dimension keeps the cells meeting [mean -+ KEEP_RADIUS];
+//   then kernels/faced_states.cl (state_face, state_point, place_faced_window) precedes this file.
 //   double contract_global(__global const double* v, __global const float* m) and
 //   double contract_private(__global const double* v, const float* m): the separable contraction
 //     sum_a0 m[a0] * (sum_a1 m[MASS_OFFSET[1] + a1] * (... v[a0*PADDED_STRIDE[0] + ...])),
@@ -45,40 +46,6 @@ void grid_point(ulong flat, int dims, __constant double* lb, __constant double* 
     out[dim] = lb[dim] + (double)k * eta[dim];
   }
 }
-
-#ifdef FACED_STATES
-// Face k of state dimension dim (uniform: lb + (k - 1/2) eta); beyond a faced dimension's grid the
-// faces continue with its outermost cells' widths, as Grid::face.
-double state_face(int dim, int k) {
-  if (!STATE_FACED[dim]) return STATE_LB[dim] + ((double)k - 0.5) * STATE_ETA[dim];
-  const int count = STATE_COUNT[dim];
-  __constant double* f = STATE_FACES + FACE_START[dim];
-  if (k < 0) return f[0] + (double)k * (f[1] - f[0]);
-  if (k > count) return f[count] + (double)(k - count) * (f[count] - f[count - 1]);
-  return f[k];
-}
-
-// The cell of a faced dimension containing v, clamped to 0..count-1 (Grid::clamped_cell).
-int faced_cell(int dim, double v) {
-  __constant double* f = STATE_FACES + FACE_START[dim];
-  int lo = 0, hi = STATE_COUNT[dim] - 1;
-  while (lo < hi) {
-    const int mid = (lo + hi + 1) / 2;
-    if (f[mid] <= v) lo = mid;
-    else hi = mid - 1;
-  }
-  return lo;
-}
-
-// Point of a flat state index: a faced dimension's midpoints, as Grid::point.
-void state_point(ulong flat, double* out) {
-  for (int dim = STATE_DIMS - 1; dim >= 0; --dim) {
-    ulong k = flat % (ulong)STATE_COUNT[dim];
-    flat /= (ulong)STATE_COUNT[dim];
-    out[dim] = STATE_FACED[dim] ? STATE_POINTS[POINT_START[dim] + (int)k] : STATE_LB[dim] + (double)k * STATE_ETA[dim];
-  }
-}
-#endif
 
 // Padded flat offset of the state cell with the given flat index.
 uint padded_offset(uint state) {
@@ -148,28 +115,6 @@ double interval_mass(double lo, double hi, double mean, double scale) {
 // Window of dimension dim for the post mean `mean`, placed in double exactly as Grid::nearest:
 // writes window_first[dim] and the kept range keep_first[dim]..keep_last[dim] of grid indices;
 // returns the padded offset along dim of the window's first cell.
-#ifdef FACED_STATES
-// place_window() of a faced dimension (NoiseModel::dimension_window): the window starts HALF_CELLS
-// before the cell containing the mean (clamped), the kept cells meet [mean -+ KEEP_RADIUS].
-uint place_faced_window(int dim, double mean, int* window_first, int* keep_first, int* keep_last) {
-  const int count = STATE_COUNT[dim];
-  const bool finite = isfinite(mean);
-  __constant double* f = STATE_FACES + FACE_START[dim];
-  const int start = WHOLE_DIM[dim] || !finite ? 0 : faced_cell(dim, mean);
-#if TRUNCATION_NONE
-  keep_first[dim] = 0;
-  keep_last[dim] = finite ? count - 1 : -1;
-#else
-  const double lo = mean - KEEP_RADIUS[dim], hi = mean + KEEP_RADIUS[dim];
-  const bool meets = finite && !(hi < f[0] || lo > f[count]);
-  keep_first[dim] = meets ? faced_cell(dim, lo) : 0;
-  keep_last[dim] = meets ? faced_cell(dim, hi) : -1;
-#endif
-  window_first[dim] = start - HALF_CELLS[dim];
-  return (uint)start * (uint)PADDED_STRIDE[dim];
-}
-#endif
-
 uint place_window(int dim, double mean, int* window_first, int* keep_first, int* keep_last) {
 #ifdef FACED_STATES
   if (STATE_FACED[dim]) return place_faced_window(dim, mean, window_first, keep_first, keep_last);
