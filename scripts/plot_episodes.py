@@ -152,8 +152,12 @@ def draw_sets(ax, policy, suffix=""):
         x, y, w, h = box_xy(box)
         ax.add_patch(Rectangle((x, y), w, h, fc="0.4", alpha=0.5, hatch="//",
                                label="obstacles (configuration)" if index == 0 else None))
-    ax.set_xlim(lo[0] - eta[0], hi[0] + eta[0])
-    ax.set_ylim(y0 - (eta[1] if len(eta) > 1 else 0.5), y1 + (eta[1] if len(eta) > 1 else 0.5))
+    # A margin of the outermost cell's width (eta on a uniform grid).
+    ax.set_xlim(lo[0] - (faces[0][1] - faces[0][0]), hi[0] + (faces[0][-1] - faces[0][-2]))
+    if len(faces) > 1:
+        ax.set_ylim(y0 - (faces[1][1] - faces[1][0]), y1 + (faces[1][-1] - faces[1][-2]))
+    else:
+        ax.set_ylim(y0 - 0.5, y1 + 0.5)
 
 
 def main():
@@ -250,8 +254,9 @@ def main():
         ax.set_xlabel("x0")
         ax.set_ylabel("x1")
         ax.legend(loc="best", fontsize=8)
-        if len(lb) > 2:
-            others = ", ".join(f"x{i} = {round(lb[i] + index[i] * eta[i], 9):g}" for i in range(2, len(lb)))
+        if len(faces) > 2:
+            point = [0.5 * (f[k] + f[k + 1]) for f, k in zip(faces, index)]
+            others = ", ".join(f"x{i} = {round(point[i], 9):g}" for i in range(2, len(faces)))
             ax.set_title(f"{name}: V_0 over x0/x1 at {others}", fontsize=9)
         else:
             ax.set_title(f"{name}: V_0 over x0/x1")
