@@ -34,13 +34,26 @@ def read_policy(path):
         config_text = f["config"][()]
         if isinstance(config_text, bytes):
             config_text = config_text.decode()
+        lb = np.asarray(f["states/lb"][()], dtype=float)
+        eta = np.asarray(f["states/eta"][()], dtype=float)
+        counts = np.asarray(f["states/counts"][()], dtype=int)
+        # Cell faces per dimension: stored by newer files (docs/policy_file.md), else uniform.
+        if "faces" in f["states"]:
+            faces = [np.asarray(f[f"states/faces/{d}"][()], dtype=float) for d in range(len(counts))]
+        else:
+            faces = [lb[d] + (np.arange(counts[d] + 1) - 0.5) * eta[d] for d in range(len(counts))]
         return {
             "config": yaml.safe_load(config_text),
-            "lb": np.asarray(f["states/lb"][()], dtype=float),
-            "eta": np.asarray(f["states/eta"][()], dtype=float),
-            "counts": np.asarray(f["states/counts"][()], dtype=int),
+            "faces": faces,
+            "counts": counts,
             "values": np.asarray(f["values"][0]),  # V_0, shape (n0, n1, ...)
         }
+
+
+def cell_index(faces, state):
+    """The cell per dimension holding `state` (clipped to the grid)."""
+    return np.array([int(np.clip(np.searchsorted(f, x, side="right") - 1, 0, len(f) - 2))
+                     for f, x in zip(faces, state)])
 
 
 def read_episodes(path):
@@ -121,10 +134,10 @@ def boxes_of(region):
 
 
 def draw_sets(ax, policy, suffix=""):
-    lb, eta, counts = policy["lb"], policy["eta"], policy["counts"]
-    lo = lb - eta / 2
-    hi = lb + (counts - 1) * eta + eta / 2
-    y0, y1 = (lo[1], hi[1]) if len(lb) > 1 else (-0.5, 0.5)
+    faces = policy["faces"]
+    lo = np.array([f[0] for f in faces])
+    hi = np.array([f[-1] for f in faces])
+    y0, y1 = (lo[1], hi[1]) if len(faces) > 1 else (-0.5, 0.5)
     ax.add_patch(Rectangle((lo[0], y0), hi[0] - lo[0], y1 - y0, fill=False, ec="0.3", lw=1.5, label="grid"))
     spec = policy["config"].get("spec", {}) or {}
     styles = {"target": dict(fc="tab:green", alpha=0.35), "avoid": dict(fc="tab:red", alpha=0.35),
@@ -139,8 +152,12 @@ def draw_sets(ax, policy, suffix=""):
         x, y, w, h = box_xy(box)
         ax.add_patch(Rectangle((x, y), w, h, fc="0.4", alpha=0.5, hatch="//",
                                label="obstacles (configuration)" if index == 0 else None))
-    ax.set_xlim(lo[0] - eta[0], hi[0] + eta[0])
-    ax.set_ylim(y0 - (eta[1] if len(eta) > 1 else 0.5), y1 + (eta[1] if len(eta) > 1 else 0.5))
+    # A margin of the outermost cell's width (eta on a uniform grid).
+    ax.set_xlim(lo[0] - (faces[0][1] - faces[0][0]), hi[0] + (faces[0][-1] - faces[0][-2]))
+    if len(faces) > 1:
+        ax.set_ylim(y0 - (faces[1][1] - faces[1][0]), y1 + (faces[1][-1] - faces[1][-2]))
+    else:
+        ax.set_ylim(y0 - 0.5, y1 + 0.5)
 
 
 def main():
@@ -219,28 +236,27 @@ def main():
     plt.close(fig)
 
     values = policy["values"]
-    lb, eta, counts = policy["lb"], policy["eta"], policy["counts"]
-    index = np.clip(np.floor((start - lb) / eta + 0.5).astype(int), 0, counts - 1)
+    faces = policy["faces"]
+    index = cell_index(faces, start)
     if values.ndim == 1:
         fig, ax = plt.subplots(figsize=(6.5, 4))
-        ax.plot(lb[0] + np.arange(counts[0]) * eta[0], values, "-o", ms=3)
+        ax.plot(0.5 * (faces[0][:-1] + faces[0][1:]), values, "-o", ms=3)
         ax.set_xlabel("x0")
         ax.set_ylabel("V_0")
     else:
         slice_index = (slice(None), slice(None)) + tuple(index[2:])
         plane = values[slice_index]
         fig, ax = plt.subplots(figsize=(6.5, 5.5))
-        extent = [lb[0] - eta[0] / 2, lb[0] + (counts[0] - 0.5) * eta[0],
-                  lb[1] - eta[1] / 2, lb[1] + (counts[1] - 0.5) * eta[1]]
-        image = ax.imshow(plane.T, origin="lower", extent=extent, vmin=0.0, vmax=1.0, cmap="viridis",
-                          aspect="auto", interpolation="nearest")
+        # pcolormesh draws each cell between its faces (cells of any widths).
+        image = ax.pcolormesh(faces[0], faces[1], plane.T, vmin=0.0, vmax=1.0, cmap="viridis", shading="flat")
         fig.colorbar(image, ax=ax, label="V_0 (probability)")
         ax.plot(start[0], start[1], "r*", ms=12, label="start")
         ax.set_xlabel("x0")
         ax.set_ylabel("x1")
         ax.legend(loc="best", fontsize=8)
-        if len(lb) > 2:
-            others = ", ".join(f"x{i} = {round(lb[i] + index[i] * eta[i], 9):g}" for i in range(2, len(lb)))
+        if len(faces) > 2:
+            point = [0.5 * (f[k] + f[k + 1]) for f, k in zip(faces, index)]
+            others = ", ".join(f"x{i} = {round(point[i], 9):g}" for i in range(2, len(faces)))
             ax.set_title(f"{name}: V_0 over x0/x1 at {others}", fontsize=9)
         else:
             ax.set_title(f"{name}: V_0 over x0/x1")

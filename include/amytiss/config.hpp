@@ -29,11 +29,18 @@ struct Region {
   explicit Region(std::vector<Box> list) : boxes(std::move(list)) {}
 };
 
-/// A uniform grid over a box: points lb + k*eta, k = 0..n-1, n = floor((ub-lb)/eta + 0.5) + 1.
+/// A rectilinear grid: per dimension either uniform, points lb + k*eta, k = 0..n-1,
+/// n = floor((ub-lb)/eta + 0.5) + 1, cell k = [lb + (k - 1/2)*eta, lb + (k + 1/2)*eta]; or given
+/// by its cell faces (states only), cell k = [faces[k], faces[k+1]] with its midpoint as point.
 struct GridSpec {
   std::vector<double> lb;
   std::vector<double> ub;
   std::vector<double> eta;  ///< spacing per dimension, > 0
+  /// Cell faces per dimension (state units): empty when every dimension is uniform, else one entry
+  /// per dimension, empty for a uniform one or n + 1 strictly increasing faces. A dimension with
+  /// faces holds NaN (`null` in the file) in lb, ub and eta.
+  std::vector<std::vector<double>> faces = {};
+  bool has_faces(std::size_t dim) const { return dim < faces.size() && !faces[dim].empty(); }
 };
 
 enum class NoiseType { Additive, Multiplicative };
@@ -182,6 +189,10 @@ struct OutputConfig {
 struct Config {
   std::string name;
   GridSpec states;
+  /// states.fit_sets: under guarantee system, insert a face at every face of the target, avoid,
+  /// safe and obstacle boxes inside the grid's range (fitted_states(), grid_rules.hpp), so that no
+  /// cell straddles a set's boundary. Refused under guarantee abstraction.
+  bool fit_sets = false;
   std::optional<GridSpec> inputs;        ///< absent: autonomous system (one empty input)
   std::optional<GridSpec> disturbances;  ///< absent: no adversary
   std::map<std::string, double> constants;

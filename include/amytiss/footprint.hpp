@@ -49,6 +49,7 @@ constexpr double kMaxBodyPieces = 1e8;
 /// pieces no shorter than half the finer cell side in x and y, over the reach from the
 /// cells' poses to the obstacles.
 BodyCut grid_body_cut(const GridSpec& states, const SpecConfig& spec);
+BodyCut grid_body_cut(const Grid& states, const SpecConfig& spec);
 
 /// The work of obstacle_cells(): cells x pieces x obstacles box tests (0 without obstacles), as a
 /// double so that any grid can be counted.

@@ -1,7 +1,8 @@
 #pragma once
 // Noise and exact transition probabilities (docs/semantics.md).
 //
-// T(x' | x,u,w) = P( f(x,u,w) + noise in cell(x') ), cell(x') = [x' - eta/2, x' + eta/2].
+// T(x' | x,u,w) = P( f(x,u,w) + noise in cell(x') ), cell(x') = [x' - eta/2, x' + eta/2] (or the
+// cell's faces, for a dimension given by them).
 // Separable noise (normal with diagonal covariance, uniform) gives T as a product of
 // one-dimensional cell masses, each computed exactly (erfc for normal). Full covariance uses
 // box_mass() (see its comment for the method and error bound).
@@ -24,6 +25,12 @@
 // nearest_i(mu + (zlo_i + zhi_i)/2) +- ceil((zhi_i - zlo_i)/(2 eta_i)); multiplicative: centred on
 // nearest_i(mu), h_i = ceil(max(|zlo_i|, |zhi_i|) * max|x_i| / eta_i). fixed_region r cuts at most
 // sum_i (1 - P(|s_i Z_i| <= h_i eta_i)) with s_i the largest scale.
+// A state dimension given by its faces keeps, instead of nearest +- h, the cells that meet
+// [c - R_i, c + R_i], c = mu + offset_i, with the kept radius R_i (window_radius()) in state units:
+// fixed_region r_i; cutting_probability z*s_i (normal), the kept interval's half-width (additive
+// exponential/beta/custom) or max(|zlo_i|, |zhi_i|) * max|x_i| (multiplicative); uniform a_i*s.
+// h_i is then the most cells such a window reaches on either side of the cell containing c
+// (clamped to the grid), so the window still lies in clamp(cell(c)) +- h_i.
 // Cells outside the window get probability 0, so every value computed is a lower bound.
 // Multiplicative noise: noise_i scales with |x_i| of the current state (diagonal only).
 #include <cstddef>
@@ -122,12 +129,19 @@ class NoiseModel {
   double box_mass(const double* lo, const double* hi, const double* mean) const;
   double box_mass_tolerance() const { return box_mass_tolerance_; }
 
+  /// Kept radius per dimension (state units) of a dimension given by its faces (see above); 0 for
+  /// a uniform one, whose window is nearest +- h.
+  const std::vector<double>& window_radius() const { return window_radius_; }
   /// Clipped window for post mean `mean`: first[i]..last[i] (inclusive grid indices). Returns
   /// false when the window misses the grid in some dimension (all mass leaves the grid).
   bool window(const Grid& states, const double* mean, std::int64_t* first, std::int64_t* last) const;
   /// The same for one dimension: the window of post coordinate `mean` along `dim`.
   bool dimension_window(const Grid& states, std::size_t dim, double mean, std::int64_t* first,
                         std::int64_t* last) const;
+  /// The union of dimension_window() over the post coordinates in [m_lo, m_hi] (nearest() is
+  /// monotone: it is the span from m_lo's window to m_hi's). False when every window misses the grid.
+  bool window_range(const Grid& states, std::size_t dim, double m_lo, double m_hi, std::int64_t* first,
+                    std::int64_t* last) const;
 
   /// Probability T(x'|x,u,w) of the state cell `target` (flat index) for post mean `mean` from
   /// current state x (used by the reference engine and tests): 0 outside the window.
@@ -143,6 +157,8 @@ class NoiseModel {
   std::vector<double> covariance_;       // full n*n, row-major
   std::vector<double> cholesky_;         // lower triangular, row-major (full covariance)
   std::vector<double> lb_, eta_;        // the state grid's (cell bounds lb + (k -+ 1/2)*eta)
+  std::vector<std::vector<double>> faces_;  // a dimension's faces, empty for a uniform one
+  std::vector<double> window_radius_;
   std::vector<std::size_t> counts_;     // the state grid's points per dimension
   std::vector<std::int64_t> window_half_cells_;
   std::vector<char> whole_grid_dims_;  // truncation none (and some noise): the whole dimension
@@ -163,6 +179,10 @@ class NoiseModel {
   void set_up_normal(const NoiseConfig& config);
   void set_up_window(const NoiseConfig& config, const Grid& states);
   void set_half_cells(std::size_t dim, double half_cells);
+  void set_radius(std::size_t dim, double radius);
+  double face(std::size_t dim, std::int64_t k) const {
+    return faces_[dim].empty() ? lb_[dim] + (double(k) - 0.5) * eta_[dim] : faces_[dim][std::size_t(k)];
+  }
   void set_up_fixed_region(const NoiseConfig& config, const std::vector<double>& largest_scale);
   void set_up_cutting_probability(const NoiseConfig& config, const std::vector<double>& largest_scale);
   void set_up_custom_error_bound();

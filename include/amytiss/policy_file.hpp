@@ -4,7 +4,10 @@
 //                    computed_by, run_id (16 hex digits), engine_version, horizon, spec,
 //                    content_digest (16 hex digits over all attributes and datasets)
 //   /config            string: canonical YAML of the configuration (to_yaml)
-//   /states/{lb,eta,counts}, /inputs/{lb,eta,counts}   float64 / uint64 vectors
+//   /states/{lb,eta,counts}, /inputs/{lb,eta,counts}   float64 / uint64 vectors (eta NaN for a
+//                      state dimension given by its faces)
+//   /states/faces/<d>  float64 (n_d + 1,) the cell faces of state dimension d (every dimension;
+//                      absent in older files, whose grids are uniform)
 //   /values            float64 (horizon+1, n0, n1, ...)   V_k(x); float32 rounded down with
 //                      output.values: float32_lower
 //   /input_index       uint8/16/32 (horizon, n0, n1, ...) flat index of u*(x,k) in the input grid,

@@ -53,7 +53,9 @@ void check_state_option(const Options& options, const Grid& states) {
                      std::to_string(states.dims() - 1) + ")");
   if (!states.cell_of(options.at.data()))
     throw UsageError("--at: the state " + format_values(options.at) +
-                     " lies outside the grid (states.lb - eta/2 to states.ub + eta/2)");
+                     " lies outside the grid (" +
+                     (states.all_uniform() ? std::string("states.lb - eta/2 to states.ub + eta/2")
+                                           : "the box " + covered_box_text(states)) + ")");
 }
 
 std::string output_path(const Options& options, const Config& config) {

@@ -25,6 +25,13 @@ std::string counts_text(const Grid& grid) {
 
 }  // namespace
 
+std::string covered_box_text(const Grid& grid) {
+  std::string text;
+  for (std::size_t dim = 0; dim < grid.dims(); ++dim)
+    text += (dim ? " x [" : "[") + format_number(grid.covered_low(dim)) + ", " + format_number(grid.covered_high(dim)) + "]";
+  return text;
+}
+
 std::string format_seconds(double seconds) {
   char text[32];
   std::snprintf(text, sizeof text, seconds < 10 ? "%.3f s" : "%.1f s", seconds);
@@ -36,6 +43,14 @@ void print_sizes(const Abstraction& abstraction) {
               abstraction.states.size(), counts_text(abstraction.states).c_str(),
               abstraction.inputs.size(), counts_text(abstraction.inputs).c_str(),
               abstraction.disturbances.size(), counts_text(abstraction.disturbances).c_str());
+  // A grid with faces: where its cells are, which the counts alone no longer say.
+  if (!abstraction.states.all_uniform()) {
+    std::string faced;
+    for (std::size_t dim = 0; dim < abstraction.states.dims(); ++dim)
+      if (!abstraction.states.uniform(dim)) faced += (faced.empty() ? "" : ", ") + std::to_string(dim);
+    std::printf("state grid covers %s (cells given by their faces in dimension %s)\n",
+                covered_box_text(abstraction.states).c_str(), faced.c_str());
+  }
   std::printf("state-input pairs: %zu, state-input-disturbance triples: %zu, horizon: %u\n",
               abstraction.pairs(), abstraction.triples(), abstraction.horizon);
 }

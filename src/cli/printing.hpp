@@ -13,7 +13,9 @@ namespace amytiss::cli {
 
 /// "0.123 s" below 10 s, else "12.3 s".
 std::string format_seconds(double seconds);
-/// Grid sizes, pairs and triples, and the horizon.
+/// "[lo0, hi0] x [lo1, hi1]": the box the grid's cells cover (outermost faces).
+std::string covered_box_text(const Grid& grid);
+/// Grid sizes (with faces: also the box covered), pairs and triples, and the horizon.
 void print_sizes(const Abstraction& abstraction);
 /// The engine's memory estimate (docs/engine.md).
 void print_memory_estimate(const Abstraction& abstraction);

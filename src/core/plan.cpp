@@ -7,6 +7,7 @@
 #include "amytiss/errors.hpp"
 #include "amytiss/resources.hpp"
 #include "amytiss/format.hpp"
+#include "amytiss/grid_rules.hpp"
 #include "bounds/system_engine.hpp"
 #include "opencl/layout.hpp"
 #include "opencl/run.hpp"
@@ -137,7 +138,7 @@ SynthesisPlan plan_synthesis(const Abstraction& a, const SynthesisOptions& optio
   SynthesisPlan plan;
   plan.multiply_adds_per_step = planned_multiply_adds_per_step(a);
   if (a.config.spec.obstacles)
-    note(plan, "footprint: " + footprint_work_text(a.config.states, a.config.spec) + " to find the cells it may touch, " +
+    note(plan, "footprint: " + footprint_work_text(fitted_states(a.config), a.config.spec) + " to find the cells it may touch, " +
                    "at most " + format_number(kMaxFootprintBoxTests) + " accepted");
   const bool any = scope == EngineScope::Any;
   check_host_memory(a, options, plan);

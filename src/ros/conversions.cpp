@@ -213,11 +213,11 @@ MarkedSets marked_sets_from_yaml(const std::string& config_yaml) {
 visualization_msgs::MarkerArray make_set_markers(const amytiss::Grid& states, const MarkedSets& sets,
                                                  const std::string& frame_id) {
   visualization_msgs::MarkerArray markers;
-  // The covered set is the union of cells: half a cell beyond the outermost points.
-  std::vector<double> covered_lb = states.lb(), covered_ub = states.last_point();
+  // The covered set is the union of cells: from the lowest to the highest face.
+  std::vector<double> covered_lb(states.dims()), covered_ub(states.dims());
   for (std::size_t i = 0; i < states.dims(); ++i) {
-    covered_lb[i] -= 0.5 * states.eta()[i];
-    covered_ub[i] += 0.5 * states.eta()[i];
+    covered_lb[i] = states.covered_low(i);
+    covered_ub[i] = states.covered_high(i);
   }
   markers.markers.push_back(outline(project(covered_lb, covered_ub), frame_id, "grid_bounds", 0.2f, 0.2f, 0.2f));
   // One marker per box of a set: the set's namespace, the box's index as id.

@@ -75,6 +75,12 @@ class RequestSource {
  public:
   RequestSource(const amytiss::Policy& policy, unsigned seed) : random_(seed), steps_(0, policy.horizon - 1) {
     for (std::size_t dim = 0; dim < policy.states.dims(); ++dim) {
+      if (!policy.states.uniform(dim)) {
+        const double low = policy.states.covered_low(dim), high = policy.states.covered_high(dim);
+        const double margin = 0.005 * policy.states.eta()[dim];  // eta(): the smallest cell width
+        coordinates_.emplace_back(low + margin, high - margin);
+        continue;
+      }
       const double half = policy.states.eta()[dim] / 2;
       coordinates_.emplace_back(policy.states.lb()[dim] - half * 0.99,
                                 policy.states.lb()[dim] + (policy.states.count(dim) - 1) * policy.states.eta()[dim] +

@@ -72,6 +72,16 @@ const Problem kProblems[] = {
      "noise: {type: multiplicative, distribution: normal, covariance: [0.04, 0.01, 0.02],\n"
      "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
      "spec: {type: safety, horizon: 5, safe: {lb: [-1.5, -1.5, -1], ub: [1.5, 1.5, 1]}}\n"},
+    // A state dimension given by its cell faces, truncated windows of a radius in state units.
+    {"faces",
+     "name: faces_small\n"
+     "states: {lb: [-2, ~], ub: [2, ~], eta: [0.25, ~],\n"
+     "         faces: [~, [-2, -1.3, -0.9, -0.6, -0.4, -0.2, -0.1, 0, 0.15, 0.3, 0.6, 1, 1.5, 2]]}\n"
+     "inputs: {lb: [-0.5], ub: [0.5], eta: [0.5]}\n"
+     "dynamics: [\"0.8*x0 + 0.2*x1 + u0\", \"0.9*x1 - 0.1*x0 + 0.5*u0\"]\n"
+     "noise: {type: additive, distribution: normal, covariance: [0.04, 0.03],\n"
+     "        truncation: cutting_probability, cutting_probability: 1.0e-3}\n"
+     "spec: {type: reach_avoid, horizon: 4, target: {lb: [0.5, 0.2], ub: [1.5, 1]}, avoid: {lb: [-2, -2], ub: [-1, -1]}}\n"},
 };
 
 SynthesisOptions options_for(const EngineCase& engine) {

@@ -227,22 +227,7 @@ MassInterval MassBounds::scale_range(double x_lo, double x_hi) const {
 }
 
 bool MassBounds::window(const Grid& states, double m_lo, double m_hi, std::int64_t* first, std::int64_t* last) const {
-  const auto count = static_cast<std::int64_t>(states.count(dim_));
-  if (noise_.whole_grid_dims()[dim_]) {
-    *first = 0;
-    *last = count - 1;
-    return true;
-  }
-  if (!std::isfinite(m_lo) || !std::isfinite(m_hi)) return false;
-  // nearest() is monotone: the windows of the means in between lie between those of the ends.
-  const double offset = noise_.window_offset()[dim_];
-  const std::int64_t half = noise_.window_half_cells()[dim_];
-  const std::int64_t low_centre = states.nearest(dim_, m_lo + offset);
-  const std::int64_t high_centre = states.nearest(dim_, m_hi + offset);
-  if (low_centre - half > count - 1 || high_centre + half < 0) return false;
-  *first = std::max<std::int64_t>(0, low_centre - half);
-  *last = std::min<std::int64_t>(count - 1, high_centre + half);
-  return true;
+  return noise_.window_range(states, dim_, m_lo, m_hi, first, last);
 }
 
 DimensionBounds MassBounds::dimension_bounds(const Grid& states, double m_lo, double m_hi, double s_lo,
@@ -255,7 +240,7 @@ DimensionBounds MassBounds::dimension_bounds(const Grid& states, double m_lo, do
     return out;
   }
   const auto count = static_cast<std::int64_t>(states.count(dim_));
-  // Cell faces as the noise model computes them: lb + (k -+ 1/2) eta.
+  // Cell faces as the noise model computes them: lb + (k -+ 1/2) eta, or the listed faces.
   auto face = [&](std::int64_t k) { return states.face(dim_, k); };
   auto mass = [&](double a, double b) { return bounds(a, b, m_lo, m_hi, s_lo, s_hi); };
   auto sum = [](const MassInterval& x, const MassInterval& y) {

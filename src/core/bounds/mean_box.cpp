@@ -37,7 +37,8 @@ IntervalBox disturbance_cell(const Grid& disturbances, std::size_t disturbance) 
 
 MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, const Grid& inputs,
                            const Grid& disturbances) {
-  // Rounded outward to a binary grid far finer than the cell: boxes equal in exact arithmetic (a
+  // Rounded outward to a binary grid far finer than the cell (eta() is a faced dimension's
+  // smallest width): boxes equal in exact arithmetic (a
   // linear map on the grid gives many cells one mean) are then equal bit for bit, and share one
   // entry of bounds and one search per line of the variable elimination.
   std::vector<double> quanta;
@@ -46,9 +47,13 @@ MeanBox enclosure_mean_box(const ImageEnclosure& enclosure, const Grid& states, 
                                                                std::size_t disturbance, double* lo, double* hi,
                                                                double* expansion) {
     const std::vector<double> centre = states.point(cell);
+    std::vector<std::size_t> multi(centre.size());
+    if (!states.all_uniform()) states.multi_index(cell, multi.data());
     IntervalBox box;
     for (std::size_t j = 0; j < centre.size(); ++j)
-      box.push_back(Interval(centre[j] - 0.5 * states.eta()[j], centre[j] + 0.5 * states.eta()[j]));
+      box.push_back(states.uniform(j) ? Interval(centre[j] - 0.5 * states.eta()[j], centre[j] + 0.5 * states.eta()[j])
+                                      : Interval(states.face(j, std::int64_t(multi[j])),
+                                                 states.face(j, std::int64_t(multi[j]) + 1)));
     const std::vector<double> u = inputs.dims() ? inputs.point(input) : std::vector<double>{};
     const ImageBox image = enclosure.enclose_over(box, u, disturbance_cell(disturbances, disturbance));
     constexpr double kInfinity = std::numeric_limits<double>::infinity();

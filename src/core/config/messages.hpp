@@ -2,6 +2,7 @@
 // Helpers shared by reading a configuration (config/yaml.cpp) and validating it
 // (config/validate.cpp): error messages that name the key, the value and an example.
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -44,6 +45,13 @@ void check_noise(const NoiseConfig& noise, std::size_t n, const std::map<std::st
 /// Config::validate()'s checks of `spec.obstacles` and `spec.footprint` (obstacles_section.cpp);
 /// `states`: the state grid (its dimension, and the cells the footprint is tested on).
 void check_obstacles(const SpecConfig& spec, const GridSpec& states);
+
+/// Config::validate()'s checks of a state grid with `states.faces` (config/states_section.cpp):
+/// the faces, lb/ub/eta null exactly where faces are given, at most max_points points. Returns the
+/// number of points.
+double check_faced_states(const GridSpec& states, std::uint64_t max_points);
+/// Refuses `states.fit_sets: true` under guarantee abstraction (config/states_section.cpp).
+void check_fit_sets(const Config& config);
 
 /// Throws ConfigError naming key[i] for the first value that is NaN or infinite.
 inline void check_finite_list(const std::vector<double>& values, const std::string& key, const std::string& example) {

@@ -1,4 +1,6 @@
 // Canonical text of a configuration (all keys, fixed order, full precision) and its hash.
+#include <cmath>
+
 #include "amytiss/config.hpp"
 #include "amytiss/format.hpp"
 #include "config/messages.hpp"
@@ -23,6 +25,28 @@ std::string quoted(const std::string& text) {
 
 std::string grid_yaml(const GridSpec& grid) {
   return "{lb: " + format_list(grid.lb) + ", ub: " + format_list(grid.ub) + ", eta: " + format_list(grid.eta) + "}";
+}
+
+// The states' grid: as before faces existed unless a dimension has faces or fit_sets is on, so
+// that uniform configurations keep their text and hash. Null (~) where a dimension has faces.
+std::string states_yaml(const Config& config) {
+  const GridSpec& grid = config.states;
+  bool faced = false;
+  for (std::size_t d = 0; d < grid.faces.size(); ++d) faced = faced || grid.has_faces(d);
+  if (!faced && !config.fit_sets) return grid_yaml(grid);
+  auto list = [](const std::vector<double>& values) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + (std::isnan(values[i]) ? "~" : format_number(values[i]));
+    return text + "]";
+  };
+  std::string text = "{lb: " + list(grid.lb) + ", ub: " + list(grid.ub) + ", eta: " + list(grid.eta);
+  if (faced) {
+    text += ", faces: [";
+    for (std::size_t d = 0; d < grid.faces.size(); ++d) text += (d ? ", " : "") + (grid.has_faces(d) ? list(grid.faces[d]) : "~");
+    text += "]";
+  }
+  if (config.fit_sets) text += ", fit_sets: true";
+  return text + "}";
 }
 
 std::string box_yaml(const Box& box) { return "{lb: " + format_list(box.lb) + ", ub: " + format_list(box.ub) + "}"; }
@@ -70,7 +94,7 @@ std::string unhashed_yaml(const Config& config) {
 std::string canonical_yaml(const Config& config, bool with_unhashed_sections) {
   std::string text;
   text += "name: " + quoted(config.name) + "\n";
-  text += "states: " + grid_yaml(config.states) + "\n";
+  text += "states: " + states_yaml(config) + "\n";
   if (config.inputs) text += "inputs: " + grid_yaml(*config.inputs) + "\n";
   if (config.disturbances) text += "disturbances: " + grid_yaml(*config.disturbances) + "\n";
   if (!config.constants.empty()) {

@@ -6,6 +6,7 @@
 
 #include "amytiss/config.hpp"
 #include "amytiss/expression.hpp"
+#include "amytiss/grid.hpp"
 #include "amytiss/grid_rules.hpp"
 #include "amytiss/model.hpp"
 #include "config/messages.hpp"
@@ -65,14 +66,14 @@ std::string box_key(const std::string& key, const Region& region, std::size_t in
 // A cell in both sets would silently become avoid (avoid wins in the roles): refuse every pair of
 // a target box and an avoid box with a common grid point.
 void check_boxes_disjoint(const Box& target, const std::string& target_key, const Box& avoid,
-                          const std::string& avoid_key, const GridSpec& states) {
+                          const std::string& avoid_key, const Grid& states) {
   std::vector<double> shared;
-  for (std::size_t i = 0; i < states.lb.size(); ++i) {
+  for (std::size_t i = 0; i < states.dims(); ++i) {
     const IndexRange in_target = box_index_range(states, i, target.lb[i], target.ub[i]);
     const IndexRange in_avoid = box_index_range(states, i, avoid.lb[i], avoid.ub[i]);
     const std::int64_t first = std::max(in_target.first, in_avoid.first);
     if (first > std::min(in_target.last, in_avoid.last)) return;
-    shared.push_back(states.lb[i] + double(first) * states.eta[i]);
+    shared.push_back(states.coordinate(i, std::size_t(first)));
   }
   auto named = [](const std::string& key, const std::string& plain) {
     return key == plain ? std::string() : " " + key;
@@ -85,18 +86,18 @@ void check_boxes_disjoint(const Box& target, const std::string& target_key, cons
                                    "; expected boxes without a common grid point (shrink one of them)");
 }
 
-void check_target_avoid_disjoint(const Region& target, const Region& avoid, const GridSpec& states) {
+void check_target_avoid_disjoint(const Region& target, const Region& avoid, const Grid& states) {
   for (std::size_t j = 0; j < avoid.boxes.size(); ++j)
     for (std::size_t i = 0; i < target.boxes.size(); ++i)
       check_boxes_disjoint(target.boxes[i], box_key("spec.target", target, i), avoid.boxes[j],
                            box_key("spec.avoid", avoid, j), states);
 }
 
-void check_box(const Box& box, const std::string& key, const GridSpec& states) {
+void check_box(const Box& box, const std::string& key, const Grid& states) {
   std::string name = key.substr(key.rfind('.') + 1);
   name = name.substr(0, name.find('['));  // "avoid" of "spec.avoid[2]"
   const std::string example = name + ": {lb: [5, 5], ub: [7, 7]}";
-  const std::size_t n = states.lb.size();
+  const std::size_t n = states.dims();
   if (box.lb.size() != n)
     fail(key + ".lb", std::to_string(box.lb.size()) + " values", std::to_string(n) + " values (one per state)", example);
   if (box.ub.size() != n)
@@ -108,21 +109,21 @@ void check_box(const Box& box, const std::string& key, const GridSpec& states) {
       fail(indexed(key + ".ub", i), format_number(box.ub[i]),
            "a number >= " + key + ".lb[" + std::to_string(i) + "] = " + format_number(box.lb[i]), example);
     // The membership rule of Grid::point_in_box (grid_rules.hpp).
-    const double eta = states.eta[i];
-    const double count = double(grid_count(states.lb[i], states.ub[i], eta));
+    const std::size_t count = states.count(i);
     const IndexRange inside = box_index_range(states, i, box.lb[i], box.ub[i]);
     if (inside.first > inside.last)
       throw ConfigError(key, "the box " + format_list(box.lb) + " .. " + format_list(box.ub) +
                                  " contains no representative point of the state grid in dimension " +
-                                 std::to_string(i) + " (points " + format_number(states.lb[i]) + ", " +
-                                 format_number(states.lb[i] + eta) + ", ..., " +
-                                 format_number(states.lb[i] + (count - 1) * eta) +
+                                 std::to_string(i) + " (points " + format_number(states.coordinate(i, 0)) + ", " +
+                                 format_number(states.uniform(i) ? states.lb()[i] + states.eta()[i]
+                                                                 : states.coordinate(i, std::min<std::size_t>(1, count - 1))) +
+                                 ", ..., " + format_number(states.coordinate(i, count - 1)) +
                                  "); widen the box or refine states.eta (example: " + example + ")");
   }
 }
 
 // Each box as a single box is checked, under its own key (spec.avoid[2].lb).
-void check_region(const Region& region, const std::string& key, const GridSpec& states) {
+void check_region(const Region& region, const std::string& key, const Grid& states) {
   if (region.boxes.empty())
     fail(key, "[]", "a box or a non-empty list of boxes",
          key.substr(key.rfind('.') + 1) + ": [{lb: [5, 5], ub: [7, 7]}, {lb: [-7, 5], ub: [-5, 7]}]");
@@ -210,7 +211,8 @@ void check_dynamics(const Config& config) {
   }
 }
 
-void check_spec(const SpecConfig& spec, const GridSpec& states) {
+void check_spec(const SpecConfig& spec, const GridSpec& fitted) {
+  const Grid states(fitted);
   if (spec.unbounded) {
     const double tolerance = spec.tolerance_or_default();
     if (!(tolerance > 0 && tolerance < 1))
@@ -247,7 +249,7 @@ void check_spec(const SpecConfig& spec, const GridSpec& states) {
       }
       break;
   }
-  check_obstacles(spec, states);
+  check_obstacles(spec, fitted);
 }
 
 void check_compute(const ComputeConfig& compute) {
@@ -323,14 +325,24 @@ void check_policy_size(double state_points, const SpecConfig& spec, bool system_
 
 void Config::validate() const {
   if (name.empty()) fail("name", "\"\"", "a non-empty name", "name: robot_reach_avoid");
-  const double state_points = check_grid(states, "states", "");
+  const double given_points =
+      states.faces.empty() ? check_grid(states, "states", "") : detail::check_faced_states(states, kMaxGridPoints);
   if (inputs) check_grid(*inputs, "inputs", "; omit `inputs` for an autonomous system");
   if (disturbances) check_grid(*disturbances, "disturbances", "; omit `disturbances` when there are none");
   check_constants(constants);
   check_dynamics(*this);
   check_integrator(integrator, model.empty(), states.lb.size());
   check_noise(noise, states.lb.size(), constants);
-  check_spec(spec, states);
+  detail::check_fit_sets(*this);
+  const GridSpec fitted = fitted_states(*this);
+  double state_points = given_points;
+  if (fit_sets) {
+    state_points = double(Grid(fitted).size());
+    if (state_points > double(kMaxGridPoints))
+      throw ConfigError("states.fit_sets", "the fitted grid has " + format_number(state_points) +
+                                               " points, at most 4294967295 (2^32 - 1) are supported; use a larger eta");
+  }
+  check_spec(spec, fitted);
   check_compute(compute);
   check_guarantee(*this);
   check_policy_size(state_points, spec, guarantee == Guarantee::System);

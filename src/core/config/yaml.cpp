@@ -72,11 +72,13 @@ double read_number(const YAML::Node& node, const std::string& key, const std::st
   }
 }
 
-std::vector<double> read_number_list(const YAML::Node& node, const std::string& key,
-                                     const std::string& example) {
+// With `nulls`, null (~) stands for a dimension given by states.faces and reads as NaN.
+std::vector<double> read_number_list(const YAML::Node& node, const std::string& key, const std::string& example,
+                                     bool nulls = false) {
   if (!node.IsSequence()) fail(key, node_text(node), "a list of numbers", example);
   std::vector<double> values;
-  for (std::size_t i = 0; i < node.size(); ++i) values.push_back(read_number(node[i], indexed(key, i), example));
+  for (std::size_t i = 0; i < node.size(); ++i)
+    values.push_back(nulls && !present(node[i]) ? std::nan("") : read_number(node[i], indexed(key, i), example));
   return values;
 }
 
@@ -123,6 +125,35 @@ GridSpec read_grid(const YAML::Node& node, const std::string& key, const std::st
   grid.lb = read_number_list(required(node, "lb", key + ".lb", example), key + ".lb", example);
   grid.ub = read_number_list(required(node, "ub", key + ".ub", example), key + ".ub", example);
   grid.eta = read_number_list(required(node, "eta", key + ".eta", example), key + ".eta", example);
+  return grid;
+}
+
+bool read_flag(const YAML::Node& node, const std::string& key, const std::string& example) {
+  const std::string text = node.IsScalar() ? node.Scalar() : node_text(node);
+  if (node.IsScalar() && (text == "true" || text == "false")) return text == "true";
+  fail(key, "'" + text + "'", "true or false", example);
+}
+
+// states: a grid whose dimensions may be given by their faces (lb, ub, eta null there or, when
+// every dimension has faces, left out), and fit_sets.
+GridSpec read_states(const YAML::Node& node, Config& config) {
+  const std::string example = "{lb: [-10, ~], ub: [10, ~], eta: [0.5, ~], faces: [~, [-1, 0, 0.5, 2]]}";
+  check_keys(node, "states", {"lb", "ub", "eta", "faces", "fit_sets"}, "states: " + example);
+  if (present(node["fit_sets"])) config.fit_sets = read_flag(node["fit_sets"], "states.fit_sets", "fit_sets: true");
+  if (!present(node["faces"])) {
+    YAML::Node grid = YAML::Clone(node);
+    grid.remove("fit_sets");
+    return read_grid(grid, "states", kGridExample);
+  }
+  GridSpec grid;
+  const YAML::Node faces = node["faces"];
+  if (!faces.IsSequence()) fail("states.faces", node_text(faces), "a list with one entry per dimension", example);
+  for (std::size_t d = 0; d < faces.size(); ++d)
+    grid.faces.push_back(present(faces[d]) ? read_number_list(faces[d], indexed("states.faces", d), example)
+                                           : std::vector<double>{});
+  for (const auto& [name, list] : {std::pair{"lb", &grid.lb}, {"ub", &grid.ub}, {"eta", &grid.eta}})
+    *list = present(node[name]) ? read_number_list(node[name], std::string("states.") + name, example, true)
+                                : std::vector<double>(grid.faces.size(), std::nan(""));
   return grid;
 }
 
@@ -326,8 +357,7 @@ Config read_config(const YAML::Node& root) {
              name_example);
   Config config;
   config.name = read_string(required(root, "name", "name", name_example), "name", name_example);
-  config.states = read_grid(required(root, "states", "states", std::string("states: ") + kGridExample), "states",
-                            kGridExample);
+  config.states = read_states(required(root, "states", "states", std::string("states: ") + kGridExample), config);
   if (present(root["inputs"]))
     config.inputs = read_grid(root["inputs"], "inputs", "{lb: [-1, -1], ub: [1, 1], eta: [0.1, 0.1]}");
   if (present(root["disturbances"]))

@@ -48,6 +48,12 @@ void Hdf5Reader::corrupt(const std::string& what) const { fail("truncated or cor
 
 bool Hdf5Reader::has_attribute(const std::string& name) const { return H5Aexists(file_, name.c_str()) > 0; }
 
+bool Hdf5Reader::has_object(const std::string& name) const {
+  const htri_t exists = H5Lexists(file_, name.c_str(), H5P_DEFAULT);
+  if (exists < 0) corrupt("link '" + name + "'");
+  return exists > 0;
+}
+
 Hdf5Handle Hdf5Reader::attribute(const std::string& name) const {
   const htri_t exists = H5Aexists(file_, name.c_str());
   if (exists < 0) corrupt("attribute '" + name + "'");

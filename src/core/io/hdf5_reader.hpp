@@ -31,6 +31,8 @@ class Hdf5Reader {
   [[noreturn]] void corrupt(const std::string& what) const;
 
   bool has_attribute(const std::string& name) const;
+  /// Whether the file has a group or dataset at the absolute path `name` (its parent must exist).
+  bool has_object(const std::string& name) const;
   std::string string_attribute(const std::string& name) const;
   std::uint64_t unsigned_attribute(const std::string& name) const;
   /// A scalar string dataset (variable or fixed length).

@@ -306,7 +306,10 @@ std::string readme_text(const Abstraction& a, const ExportLayout& layout, Export
     << ". The configuration's canonical YAML is at the end.\n\n"
     << "## States\n\n"
     << "- `0.." << layout.cells - 1 << "`: the cells of the state grid, flat index row-major (last dimension "
-    << "fastest)" << (prism ? "; `model.sta` gives each cell's grid indices `k0, k1, ...` (point `lb + k*eta`)" : "")
+    << "fastest)"
+    << (prism ? std::string("; `model.sta` gives each cell's grid indices `k0, k1, ...` (point `lb + k*eta`") +
+                    (a.states.all_uniform() ? ")" : ", or the midpoint of cell k's faces in a dimension given by them)")
+              : std::string())
     << ".\n- `" << layout.sink() << "`: the sink (label `sink`), absorbing. Every row sends to it the mass that "
     << "leaves the grid or is cut by the truncation, so every row sums to 1. Reaching it counts as failure.\n";
   if (layout.adversary)

@@ -67,6 +67,9 @@ void add_grid(ContentDigest& digest, const Grid& grid) {
   digest.add(grid.lb());
   digest.add(grid.eta());
   digest.add(std::vector<std::uint64_t>(grid.counts().begin(), grid.counts().end()));
+  // Only a grid with faces adds them: uniform grids keep their digest (their faces follow from lb and eta).
+  if (!grid.all_uniform())
+    for (std::size_t d = 0; d < grid.dims(); ++d) digest.add(grid.faces(d));
 }
 
 }  // namespace

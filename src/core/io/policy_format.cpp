@@ -29,13 +29,25 @@ std::vector<hsize_t> upper_values_shape(const Policy& policy) {
   return policy.stationary ? per_cell_shape(policy.states) : cell_shape(policy.states, policy.horizon + 1);
 }
 
-void write_grid(const Hdf5Writer& writer, const std::string& group_name, const Grid& grid) {
+// lb, eta and counts per dimension (eta NaN for a dimension given by its faces, lb its first
+// point), and the faces of every dimension of the state grid, faces/<d>.
+void write_grid(const Hdf5Writer& writer, const std::string& group_name, const Grid& grid, bool with_faces) {
   writer.group(group_name);
   const std::vector<hsize_t> shape{hsize_t(grid.dims())};
   std::vector<std::uint64_t> counts(grid.counts().begin(), grid.counts().end());
+  std::vector<double> eta = grid.eta();
+  for (std::size_t d = 0; d < grid.dims(); ++d)
+    if (!grid.uniform(d)) eta[d] = std::numeric_limits<double>::quiet_NaN();
   writer.dataset(group_name + "/lb", shape, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, grid.lb().data());
-  writer.dataset(group_name + "/eta", shape, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, grid.eta().data());
+  writer.dataset(group_name + "/eta", shape, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, eta.data());
   writer.dataset(group_name + "/counts", shape, H5T_STD_U64LE, H5T_NATIVE_UINT64, counts.data());
+  if (!with_faces) return;
+  writer.group(group_name + "/faces");
+  for (std::size_t d = 0; d < grid.dims(); ++d) {
+    const std::vector<double> faces = grid.faces(d);
+    writer.dataset(group_name + "/faces/" + std::to_string(d), {hsize_t(faces.size())}, H5T_IEEE_F64LE,
+                   H5T_NATIVE_DOUBLE, faces.data());
+  }
 }
 
 void write_attributes(const Hdf5Writer& writer, const PolicyFileAttributes& attributes, const std::string& digest) {
@@ -56,6 +68,8 @@ void write_attributes(const Hdf5Writer& writer, const PolicyFileAttributes& attr
   writer.string_attribute("content_digest", digest);
 }
 
+// A dimension with eta NaN is given by its faces (faces/<d>, counts + 1 strictly increasing
+// values); a uniform one by lb and eta, and its faces, where the file has them, must be those.
 Grid read_grid(const Hdf5Reader& reader, const std::string& group_name) {
   const auto lb = reader.vector_dataset<double>(group_name + "/lb", H5T_FLOAT, H5T_NATIVE_DOUBLE);
   const auto eta = reader.vector_dataset<double>(group_name + "/eta", H5T_FLOAT, H5T_NATIVE_DOUBLE);
@@ -63,19 +77,39 @@ Grid read_grid(const Hdf5Reader& reader, const std::string& group_name) {
   if (eta.size() != lb.size() || counts.size() != lb.size())
     reader.fail("'" + group_name + "' has lb, eta and counts of different lengths (" + std::to_string(lb.size()) +
                 ", " + std::to_string(eta.size()) + ", " + std::to_string(counts.size()) + ")");
+  const bool has_faces = reader.has_object(group_name + "/faces");
+  std::vector<std::vector<double>> faces(lb.size());
   GridSpec spec;
   spec.lb = lb;
   spec.eta = eta;
   for (std::size_t dim = 0; dim < lb.size(); ++dim) {
+    const std::string name = group_name + "/faces/" + std::to_string(dim);
+    if (has_faces) faces[dim] = reader.vector_dataset<double>(name, H5T_FLOAT, H5T_NATIVE_DOUBLE);
+    if (has_faces && faces[dim].size() != counts[dim] + 1)
+      reader.fail("'" + name + "' has " + std::to_string(faces[dim].size()) + " faces, expected counts + 1 = " +
+                  std::to_string(counts[dim] + 1));
+    if (std::isnan(eta[dim]) && has_faces) {
+      for (std::size_t k = 0; k < faces[dim].size(); ++k)
+        if (!std::isfinite(faces[dim][k]) || (k > 0 && !(faces[dim][k - 1] < faces[dim][k])))
+          reader.fail("'" + name + "' needs finite, strictly increasing faces");
+      spec.faces.resize(lb.size());
+      spec.faces[dim] = faces[dim];
+      spec.ub.push_back(eta[dim]);
+      continue;
+    }
     if (!std::isfinite(lb[dim]) || !std::isfinite(eta[dim]) || !(eta[dim] > 0) || counts[dim] == 0)
       reader.fail("'" + group_name + "' dimension " + std::to_string(dim) +
-                  " needs a finite lb, eta > 0 and counts >= 1");
+                  " needs a finite lb, eta > 0 and counts >= 1 (or eta NaN and its faces in faces/" +
+                  std::to_string(dim) + ")");
     spec.ub.push_back(lb[dim] + double(counts[dim] - 1) * eta[dim]);
   }
   Grid grid(spec);
-  for (std::size_t dim = 0; dim < lb.size(); ++dim)
+  for (std::size_t dim = 0; dim < lb.size(); ++dim) {
     if (grid.count(dim) != counts[dim])
       reader.fail("'" + group_name + "/counts' does not match lb and eta in dimension " + std::to_string(dim));
+    if (has_faces && grid.uniform(dim) && grid.faces(dim) != faces[dim])
+      reader.fail("'" + group_name + "/faces/" + std::to_string(dim) + "' does not match lb and eta");
+  }
   return grid;
 }
 
@@ -251,8 +285,8 @@ void write_policy_contents(const Hdf5Writer& writer, const Policy& policy, const
   write_attributes(writer, attributes,
                    policy_digest(attributes, config_yaml, policy, stored.values(), stored.upper_values()));
   writer.string_dataset("/config", config_yaml);
-  write_grid(writer, "/states", policy.states);
-  write_grid(writer, "/inputs", policy.inputs);
+  write_grid(writer, "/states", policy.states, true);
+  write_grid(writer, "/inputs", policy.inputs, false);
   stored.write(writer, "/values", cell_shape(policy.states, policy.horizon + 1), stored.values());
   writer.dataset("/input_index", cell_shape(policy.states, policy.horizon), input_index_file_type(policy.inputs.size()),
                  H5T_NATIVE_UINT32, policy.input_index.data(), Hdf5Writer::Filters::Compressed);

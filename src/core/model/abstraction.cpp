@@ -5,6 +5,7 @@
 
 #include "amytiss/errors.hpp"
 #include "amytiss/footprint.hpp"
+#include "amytiss/grid_rules.hpp"
 #include "common/require.hpp"
 
 namespace amytiss {
@@ -60,7 +61,7 @@ Abstraction Abstraction::from_parts(const Config& config, std::shared_ptr<const 
                                     const ProgressCallback& progress) {
   Abstraction abstraction;
   abstraction.config = config;
-  abstraction.states = Grid(config.states);
+  abstraction.states = Grid(fitted_states(config));
   require(abstraction.states.dims() > 0, "at least one state dimension");
   if (config.inputs) abstraction.inputs = Grid(*config.inputs);
   if (config.disturbances) abstraction.disturbances = Grid(*config.disturbances);

@@ -183,18 +183,42 @@ double noise_density_slope(const Abstraction& abstraction, std::string* why_not)
   return std::exp(-0.5) / denominator * (1 + kRoundingSlack);
 }
 
+namespace {
+
+// Volume of the cells that are not fixed at zero, cell by cell (a grid with faces).
+double positive_volume(const Abstraction& abstraction) {
+  const Grid& states = abstraction.states;
+  std::vector<std::size_t> multi(states.dims());
+  double volume = 0;
+  for (std::size_t cell = 0; cell < states.size(); ++cell) {
+    if (abstraction.roles[cell] == CellRole::FixedZero) continue;
+    states.multi_index(cell, multi.data());
+    double cell_volume = 1;
+    for (std::size_t d = 0; d < states.dims(); ++d) cell_volume *= states.width(d, multi[d]);
+    volume += cell_volume;
+  }
+  return volume;
+}
+
+}  // namespace
+
 AprioriError apriori_error(const Abstraction& abstraction, std::size_t max_jacobians) {
   AprioriError error;
   const Grid& states = abstraction.states;
   double cell_volume = 1, diameter_squared = 0;
-  for (double eta : states.eta()) {
+  for (std::size_t d = 0; d < states.dims(); ++d) {
+    // A dimension given by its faces: its widest cell bounds the diameter.
+    double eta = states.eta()[d];
+    if (!states.uniform(d))
+      for (std::size_t k = 0; k < states.count(d); ++k) eta = std::max(eta, states.width(d, k));
     cell_volume *= eta;
     diameter_squared += eta * eta;
   }
   error.delta = std::sqrt(diameter_squared) * (1 + kRoundingSlack);
   const auto positive_cells = std::count_if(abstraction.roles.begin(), abstraction.roles.end(),
                                             [](CellRole role) { return role != CellRole::FixedZero; });
-  error.measure = double(positive_cells) * cell_volume * (1 + kRoundingSlack);
+  error.measure = states.all_uniform() ? double(positive_cells) * cell_volume * (1 + kRoundingSlack)
+                                       : positive_volume(abstraction) * (1 + kRoundingSlack);
   error.horizon = abstraction.unbounded ? kInfinity : double(abstraction.horizon);
 
   std::string why_not;

@@ -69,27 +69,25 @@ std::vector<BodyPiece> body_pieces(const Footprint& footprint, const BodyCut& cu
   return pieces;
 }
 
-BodyCut grid_body_cut(const GridSpec& states, const SpecConfig& spec) {
+BodyCut grid_body_cut(const Grid& states, const SpecConfig& spec) {
   const Footprint& footprint = *spec.footprint;
   const std::size_t x = footprint.pose[0], y = footprint.pose[1];
-  auto extent = [&](std::size_t dim, double& lo, double& hi) {
-    const double last = states.lb[dim] + (grid_points(states.lb[dim], states.ub[dim], states.eta[dim]) - 1) *
-                                             states.eta[dim];
-    lo = states.lb[dim] - 0.5 * states.eta[dim];
-    hi = last + 0.5 * states.eta[dim];
-  };
-  double x_lo, x_hi, y_lo, y_hi;
-  extent(x, x_lo, x_hi);
-  extent(y, y_lo, y_hi);
-  const double min_side = std::min(states.eta[x], states.eta[y]) / kPiecesPerCellSide;
-  return body_cut(footprint, min_side, obstacle_reach(*spec.obstacles, x_lo, x_hi, y_lo, y_hi));
+  // eta() of a dimension given by its faces is its smallest cell width.
+  const double min_side = std::min(states.eta()[x], states.eta()[y]) / kPiecesPerCellSide;
+  return body_cut(footprint, min_side,
+                  obstacle_reach(*spec.obstacles, states.covered_low(x), states.covered_high(x), states.covered_low(y),
+                                 states.covered_high(y)));
 }
+
+BodyCut grid_body_cut(const GridSpec& states, const SpecConfig& spec) { return grid_body_cut(Grid(states), spec); }
 
 namespace {
 
 double cell_count(const GridSpec& states) {
   double cells = 1;
-  for (std::size_t d = 0; d < states.lb.size(); ++d) cells *= grid_points(states.lb[d], states.ub[d], states.eta[d]);
+  for (std::size_t d = 0; d < states.lb.size(); ++d)
+    cells *= states.has_faces(d) ? double(states.faces[d].size() - 1)
+                                 : grid_points(states.lb[d], states.ub[d], states.eta[d]);
   return cells;
 }
 
@@ -158,13 +156,12 @@ std::vector<bool> obstacle_cells(const Grid& states, const SpecConfig& spec, con
   if (!spec.footprint || spec.footprint->pose.size() != 3)
     throw std::logic_error("obstacle_cells: expected a validated configuration with a footprint");
   const Footprint& footprint = *spec.footprint;
-  GridSpec grid;
-  grid.lb = states.lb();
-  grid.eta = states.eta();
-  grid.ub = states.last_point();
-  const std::vector<BodyPiece> pieces = body_pieces(footprint, grid_body_cut(grid, spec));
+  const std::vector<BodyPiece> pieces = body_pieces(footprint, grid_body_cut(states, spec));
   std::vector<std::size_t> multi(states.dims());
   auto cell_range = [&](unsigned dim) {
+    if (!states.uniform(dim))
+      return rounded_outward(states.face(dim, std::int64_t(multi[dim])), states.face(dim, std::int64_t(multi[dim]) + 1),
+                             kExactRoundingSteps);
     const double centre = states.lb()[dim] + double(multi[dim]) * states.eta()[dim];
     const double half = 0.5 * states.eta()[dim];
     return rounded_outward(centre - half, centre + half, kExactRoundingSteps);

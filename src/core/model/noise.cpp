@@ -36,6 +36,9 @@ NoiseModel::NoiseModel(const NoiseConfig& config, const Grid& states, const std:
       counts_(states.counts()),
       grid_size_(states.size()) {
   const std::size_t n = dims_;
+  faces_.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!states.uniform(i)) faces_[i] = states.faces(i);
   if (distribution_ == Distribution::Normal) {
     set_up_normal(config);
   } else if (distribution_ == Distribution::Uniform) {
@@ -88,6 +91,7 @@ void NoiseModel::set_up_normal(const NoiseConfig& config) {
 void NoiseModel::set_up_window(const NoiseConfig& config, const Grid& states) {
   const std::size_t n = dims_;
   window_offset_.assign(n, 0.0);
+  window_radius_.assign(n, 0.0);
 
   // The largest scale per dimension over the grid bounds the window for every current state.
   std::vector<double> largest_scale(n);
@@ -122,12 +126,28 @@ void NoiseModel::set_up_window(const NoiseConfig& config, const Grid& states) {
       window_half_cells_[i] = 0;
       whole_grid_dims_[i] = 0;
       window_offset_[i] = 0.0;
+      window_radius_[i] = 0.0;
     }
   }
 }
 
 void NoiseModel::set_half_cells(std::size_t dim, double half_cells) {
   window_half_cells_[dim] = static_cast<std::int64_t>(std::min(half_cells, kMaxHalfCells));
+}
+
+// The most cells a window of radius R reaches beyond the cell containing its centre, over every
+// cell of the dimension; cells beyond the grid do not count (the window is clipped).
+void NoiseModel::set_radius(std::size_t dim, double radius) {
+  window_radius_[dim] = radius;
+  const std::vector<double>& f = faces_[dim];
+  const auto n = static_cast<std::int64_t>(f.size()) - 1;
+  auto cell = [&](double v) {
+    return std::clamp<std::int64_t>(std::int64_t(std::upper_bound(f.begin(), f.end(), v) - f.begin()) - 1, 0, n - 1);
+  };
+  std::int64_t half = 0;
+  for (std::int64_t c = 0; c < n && half < n - 1; ++c)
+    half = std::max({half, c - cell(f[std::size_t(c)] - radius), cell(f[std::size_t(c) + 1] + radius) - c});
+  window_half_cells_[dim] = half;
 }
 
 void NoiseModel::set_up_fixed_region(const NoiseConfig& config, const std::vector<double>& largest_scale) {
@@ -137,9 +157,10 @@ void NoiseModel::set_up_fixed_region(const NoiseConfig& config, const std::vecto
   for (std::size_t i = 0; i < n; ++i) {
     const double region = config.fixed_region[i];
     require(std::isfinite(region) && region > 0, "positive fixed_region half-widths");
-    set_half_cells(i, std::floor(region / eta_[i] + 1e-9));
-    // The window contains [mu - h*eta, mu + h*eta] (|mu - nearest point| <= eta/2).
-    const double kept = double(window_half_cells_[i]) * eta_[i];
+    if (faces_[i].empty()) set_half_cells(i, std::floor(region / eta_[i] + 1e-9));
+    else set_radius(i, region);
+    // The window contains [mu - h*eta, mu + h*eta] (|mu - nearest point| <= eta/2), or [mu - R, mu + R].
+    const double kept = faces_[i].empty() ? double(window_half_cells_[i]) * eta_[i] : region;
     if (largest_scale[i] > 0) {
       if (distribution_ == Distribution::Normal)
         cut += 2.0 * upper_tail(kept / largest_scale[i]);
@@ -161,9 +182,10 @@ void NoiseModel::set_up_cutting_probability(const NoiseConfig& config, const std
     const double z = normal_upper_quantile(gamma / (2.0 * double(std::max<std::size_t>(n, 1))));
     double cut = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      set_half_cells(i, std::ceil(z * largest_scale[i] / eta_[i]));
-      if (largest_scale[i] > 0)
-        cut += 2.0 * upper_tail(double(window_half_cells_[i]) * eta_[i] / largest_scale[i]);
+      if (faces_[i].empty()) set_half_cells(i, std::ceil(z * largest_scale[i] / eta_[i]));
+      else set_radius(i, z * largest_scale[i]);
+      const double kept = faces_[i].empty() ? double(window_half_cells_[i]) * eta_[i] : window_radius_[i];
+      if (largest_scale[i] > 0) cut += 2.0 * upper_tail(kept / largest_scale[i]);
     }
     cut_mass_bound_ = std::min(gamma, cut);
   } else if (!laws_.empty()) {
@@ -177,17 +199,19 @@ void NoiseModel::set_up_cutting_probability(const NoiseConfig& config, const std
         zhi = law.shift + std::log(double(std::max<std::size_t>(n, 1)) / gamma) / law.rate;
         if (largest_scale[i] > 0) cut += gamma / double(std::max<std::size_t>(n, 1));
       }
-      if (type_ == NoiseType::Additive) {
-        window_offset_[i] = 0.5 * (zlo + zhi);
-        set_half_cells(i, std::ceil(0.5 * (zhi - zlo) / eta_[i]));
-      } else {
-        set_half_cells(i, std::ceil(std::max(std::fabs(zlo), std::fabs(zhi)) * largest_scale[i] / eta_[i]));
-      }
+      if (type_ == NoiseType::Additive) window_offset_[i] = 0.5 * (zlo + zhi);
+      const double radius = type_ == NoiseType::Additive ? 0.5 * (zhi - zlo)
+                                                         : std::max(std::fabs(zlo), std::fabs(zhi)) * largest_scale[i];
+      if (faces_[i].empty()) set_half_cells(i, std::ceil(radius / eta_[i]));
+      else set_radius(i, radius);
     }
     cut_mass_bound_ = std::min(gamma, cut);
   } else {
     // The window covers the whole support of the uniform law: nothing is cut.
-    for (std::size_t i = 0; i < n; ++i) set_half_cells(i, std::ceil(largest_scale[i] / eta_[i]));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (faces_[i].empty()) set_half_cells(i, std::ceil(largest_scale[i] / eta_[i]));
+      else set_radius(i, largest_scale[i]);
+    }
     cut_mass_bound_ = 0.0;
   }
 }
@@ -236,6 +260,7 @@ double NoiseModel::interval_mass(std::size_t dim, double lo, double hi, double m
 }
 
 double NoiseModel::cell_mass(std::size_t dim, std::size_t k, double mean, double scale) const {
+  if (!faces_[dim].empty()) return interval_mass(dim, faces_[dim][k], faces_[dim][k + 1], mean, scale);
   // lb + (k +- 1/2)*eta: neighbouring cells share the exact same bound.
   const double lo = lb_[dim] + (double(k) - 0.5) * eta_[dim];
   const double hi = lb_[dim] + (double(k) + 0.5) * eta_[dim];
@@ -256,7 +281,7 @@ void NoiseModel::cell_masses(std::size_t dim, std::int64_t first, std::int64_t l
   z.resize(faces);
   tail.resize(faces);
   for (std::size_t f = 0; f < faces; ++f) {
-    const double face = lb_[dim] + (double(first + std::int64_t(f)) - 0.5) * eta_[dim];
+    const double face = this->face(dim, first + std::int64_t(f));
     z[f] = (face - mean) / scale;
     tail[f] = upper_tail(z[f] >= 0 ? z[f] : -z[f]);
   }
@@ -289,6 +314,11 @@ bool NoiseModel::window(const Grid& states, const double* mean, std::int64_t* fi
 
 bool NoiseModel::dimension_window(const Grid& states, std::size_t dim, double mean, std::int64_t* first,
                                   std::int64_t* last) const {
+  return window_range(states, dim, mean, mean, first, last);
+}
+
+bool NoiseModel::window_range(const Grid& states, std::size_t dim, double m_lo, double m_hi, std::int64_t* first,
+                              std::int64_t* last) const {
   const auto count = static_cast<std::int64_t>(counts_[dim]);
   if (whole_grid_dims_[dim]) {
     *first = 0;
@@ -296,12 +326,21 @@ bool NoiseModel::dimension_window(const Grid& states, std::size_t dim, double me
     return true;
   }
   // A non-finite post state carries no mass onto the grid.
-  if (!std::isfinite(mean)) return false;
-  const std::int64_t center = states.nearest(dim, mean + window_offset_[dim]);
+  if (!std::isfinite(m_lo) || !std::isfinite(m_hi)) return false;
+  if (!faces_[dim].empty()) {
+    const double lo = m_lo + window_offset_[dim] - window_radius_[dim];
+    const double hi = m_hi + window_offset_[dim] + window_radius_[dim];
+    if (hi < faces_[dim].front() || lo > faces_[dim].back()) return false;
+    *first = states.clamped_cell(dim, lo);
+    *last = states.clamped_cell(dim, hi);
+    return true;
+  }
+  const std::int64_t low_centre = states.nearest(dim, m_lo + window_offset_[dim]);
+  const std::int64_t high_centre = states.nearest(dim, m_hi + window_offset_[dim]);
   const std::int64_t half = window_half_cells_[dim];
-  if (center - half > count - 1 || center + half < 0) return false;
-  *first = std::max<std::int64_t>(0, center - half);
-  *last = std::min<std::int64_t>(count - 1, center + half);
+  if (low_centre - half > count - 1 || high_centre + half < 0) return false;
+  *first = std::max<std::int64_t>(0, low_centre - half);
+  *last = std::min<std::int64_t>(count - 1, high_centre + half);
   return true;
 }
 
@@ -322,8 +361,8 @@ double NoiseModel::transition_probability(const Grid& states, std::size_t target
   }
   double lo[kMaxFullCovarianceDims], hi[kMaxFullCovarianceDims];
   for (std::size_t i = 0; i < dims_; ++i) {
-    lo[i] = lb_[i] + (double(multi[i]) - 0.5) * eta_[i];
-    hi[i] = lb_[i] + (double(multi[i]) + 0.5) * eta_[i];
+    lo[i] = face(i, std::int64_t(multi[i]));
+    hi[i] = faces_[i].empty() ? lb_[i] + (double(multi[i]) + 0.5) * eta_[i] : face(i, std::int64_t(multi[i]) + 1);
   }
   return box_mass(lo, hi, mean);
 }

@@ -160,6 +160,39 @@ std::string contraction_source(const Layout& layout, const std::string& name,
   return s.str();
 }
 
+namespace {
+
+// A state grid with faces (kernels/engine.cl, FACED_STATES): per dimension whether it is given by
+// its faces, where they start in STATE_FACES and its points in STATE_POINTS (count + 1 faces and
+// count points each, dimension after dimension), and its kept radius (NoiseModel::window_radius).
+std::string faced_prelude(const Abstraction& a) {
+  std::vector<long long> faced, start;
+  std::vector<double> faces, points;
+  for (std::size_t d = 0; d < a.states.dims(); ++d) {
+    faced.push_back(a.states.uniform(d) ? 0 : 1);
+    start.push_back(static_cast<long long>(faces.size()));
+    if (a.states.uniform(d)) continue;
+    const std::vector<double> listed = a.states.faces(d);
+    faces.insert(faces.end(), listed.begin(), listed.end());
+    for (std::size_t k = 0; k < a.states.count(d); ++k) points.push_back(a.states.coordinate(d, k));
+  }
+  // A dimension's points start where its faces do, less one per faced dimension before it.
+  std::vector<long long> point_start;
+  long long before = 0;
+  for (std::size_t d = 0; d < faced.size(); ++d) {
+    point_start.push_back(start[d] - before);
+    before += faced[d];
+  }
+  auto real = [](double v) { return c_double_literal(v); };
+  auto integer = [](long long v) { return int_text(v); };
+  return "#define FACED_STATES 1\n" + constant_array("int", "STATE_FACED", faced, integer) +
+         constant_array("int", "FACE_START", start, integer) + constant_array("int", "POINT_START", point_start, integer) +
+         constant_array("double", "STATE_FACES", faces, real) + constant_array("double", "STATE_POINTS", points, real) +
+         constant_array("double", "KEEP_RADIUS", a.noise->window_radius(), real);
+}
+
+}  // namespace
+
 std::string opencl_prelude(const Abstraction& a, const Layout& layout, bool on_the_fly, std::size_t group_size) {
   const NoiseModel& noise = *a.noise;
   std::ostringstream s;
@@ -204,6 +237,7 @@ std::string opencl_prelude(const Abstraction& a, const Layout& layout, bool on_t
     << constant_array("double", "DIST_ETA", a.disturbances.eta(), real)
     << constant_array("int", "DIST_COUNT", counts_of(a.disturbances), integer)
     << constant_array("double", "NOISE_SCALE", noise.base_scale(), real);
+  if (!a.states.all_uniform()) s << faced_prelude(a);
   return s.str();
 }
 
@@ -211,7 +245,7 @@ std::string opencl_program_source(const Abstraction& a, bool on_the_fly, std::si
   const Layout layout(a);
   return opencl_prelude(a, layout, on_the_fly, group_size) + contraction_source(layout, "contract_global", "__global") +
          contraction_source(layout, "contract_private", "") + a.dynamics->opencl_source() + "\n" +
-         embedded_source("engine.cl");
+         (a.states.all_uniform() ? std::string() : embedded_source("faced_states.cl")) + embedded_source("engine.cl");
 }
 
 }  // namespace amytiss::detail

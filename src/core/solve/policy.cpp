@@ -24,10 +24,10 @@ std::string component_names(std::size_t dims) {
   return text + ")";
 }
 
-// The covered interval of dimension d: [lb - eta/2, last + eta/2].
+// The covered interval of dimension d: [lb - eta/2, last + eta/2], or the outermost faces.
 std::string covered_interval(const Grid& grid, std::size_t d) {
-  const double low = grid.lb()[d] - 0.5 * grid.eta()[d];
-  const double high = grid.coordinate(d, grid.count(d) - 1) + 0.5 * grid.eta()[d];
+  const double low = grid.covered_low(d);
+  const double high = grid.covered_high(d);
   return "[" + format_number(low) + ", " + format_number(high) + "]";
 }
 
@@ -71,8 +71,8 @@ std::string Policy::describe(LookupStatus status, const double* state, std::size
       for (std::size_t d = 0; d < states.dims(); ++d) {
         grid_text += (d ? " x " : "") + covered_interval(states, d);
         if (which.empty() && d < state_length) {
-          const double low = states.lb()[d] - 0.5 * states.eta()[d];
-          const double high = states.coordinate(d, states.count(d) - 1) + 0.5 * states.eta()[d];
+          const double low = states.covered_low(d);
+          const double high = states.covered_high(d);
           if (!(state[d] >= low && state[d] <= high))
             which = "x" + std::to_string(d) + " = " + format_number(state[d]) + " is not in " +
                     covered_interval(states, d);

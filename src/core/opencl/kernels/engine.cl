@@ -17,6 +17,11 @@
 //   HALF_CELLS, WHOLE_DIM, WIDTH, MASS_OFFSET, PADDED_STRIDE (int); KEEP_HALF (long: NoiseModel's h);
 //   INPUT_LB, INPUT_ETA, INPUT_COUNT;
 //   DIST_LB, DIST_ETA, DIST_COUNT; NOISE_SCALE (double, the additive scale per dimension).
+//   Only for a state grid with faces, FACED_STATES defined and: STATE_FACED, FACE_START,
+//   POINT_START (int per dimension), STATE_FACES, STATE_POINTS (double, the faced dimensions'
+//   count + 1 faces and count points one after the other), KEEP_RADIUS (double per dimension:
+//   NoiseModel::window_radius). A faced dimension keeps the cells meeting [mean -+ KEEP_RADIUS];
+//   then kernels/faced_states.cl (state_face, state_point, place_faced_window) precedes this file.
 //   double contract_global(__global const double* v, __global const float* m) and
 //   double contract_private(__global const double* v, const float* m): the separable contraction
 //     sum_a0 m[a0] * (sum_a1 m[MASS_OFFSET[1] + a1] * (... v[a0*PADDED_STRIDE[0] + ...])),
@@ -111,6 +116,9 @@ double interval_mass(double lo, double hi, double mean, double scale) {
 // writes window_first[dim] and the kept range keep_first[dim]..keep_last[dim] of grid indices;
 // returns the padded offset along dim of the window's first cell.
 uint place_window(int dim, double mean, int* window_first, int* keep_first, int* keep_last) {
+#ifdef FACED_STATES
+  if (STATE_FACED[dim]) return place_faced_window(dim, mean, window_first, keep_first, keep_last);
+#endif
   const int count = STATE_COUNT[dim];
   const double eta = STATE_ETA[dim];
   // A non-finite post state has no cell: all its mass leaves the grid.
@@ -143,8 +151,12 @@ void uniform_masses(int dim, double mean, double scale, int window_first, int ke
   for (int j = 0; j < WIDTH[dim]; ++j) {
     const int k = window_first + j;
     // The bounds as NoiseModel::cell_mass writes them: neighbours share a bound exactly.
+#ifdef FACED_STATES
+    const double mass = interval_mass(state_face(dim, k), state_face(dim, k + 1), mean, scale);
+#else
     const double mass = interval_mass(STATE_LB[dim] + ((double)k - 0.5) * STATE_ETA[dim],
                                       STATE_LB[dim] + ((double)k + 0.5) * STATE_ETA[dim], mean, scale);
+#endif
     m[MASS_OFFSET[dim] + j] = (k >= keep_first && k <= keep_last) ? (float)mass : 0.0f;
   }
 }
@@ -156,7 +168,11 @@ void bound_arguments(int dim, double mean, double scale, int window_first, doubl
   const double inverse = scale > 0.0 ? 1.0 / (scale * 1.4142135623730951) : 0.0;
   for (int b = 0; b < BOUNDS_CAPACITY; ++b) {
     const int slot = dim * BOUNDS_CAPACITY + b;
+#ifdef FACED_STATES
+    bound[slot] = state_face(dim, window_first + b);
+#else
     bound[slot] = STATE_LB[dim] + ((double)(window_first + b) - 0.5) * eta;
+#endif
     tail[slot] = fabs(bound[slot] - mean) * inverse;
   }
 }
@@ -213,7 +229,11 @@ uint compute_record(ulong state, ulong input, ulong disturbance, float* m) {
   double w[DIST_DIMS > 0 ? DIST_DIMS : 1];
   u[0] = 0.0;
   w[0] = 0.0;
+#ifdef FACED_STATES
+  state_point(state, x);
+#else
   grid_point(state, STATE_DIMS, STATE_LB, STATE_ETA, STATE_COUNT, x);
+#endif
   grid_point(input, INPUT_DIMS, INPUT_LB, INPUT_ETA, INPUT_COUNT, u);
   grid_point(disturbance, DIST_DIMS, DIST_LB, DIST_ETA, DIST_COUNT, w);
   amytiss_dynamics(x, u, w, post);
