@@ -34,6 +34,10 @@ inline std::string read_file(const fs::path& path) {
 
 inline std::string quote(const std::string& text) { return "'" + text + "'"; }
 
+/// The CLI tests' tiny configuration, and the arguments that run it quietly.
+inline const std::string kTinyConfig = std::string(AMYTISS_SOURCE_DIR) + "/test/data/cli_tiny.yaml";
+inline const std::string kTiny = "--config " + quote(kTinyConfig) + " --quiet ";
+
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {

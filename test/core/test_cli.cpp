@@ -27,9 +27,9 @@ using test_support::CliTest;
 using test_support::CommandResult;
 using test_support::kSynth;
 using test_support::quote;
+using test_support::kTinyConfig;
 
 const std::string kSourceDir = AMYTISS_SOURCE_DIR;
-const std::string kTinyConfig = kSourceDir + "/test/data/cli_tiny.yaml";
 const std::string kBadEtaConfig = kSourceDir + "/test/data/cli_bad_eta.yaml";
 // cli_tiny.yaml: 9 x 9 states, 3 x 3 inputs, horizon 4.
 constexpr std::size_t kTinyStates = 81, kTinyInputs = 9;

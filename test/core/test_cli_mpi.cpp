@@ -17,9 +17,9 @@ using test_support::CliTest;
 using test_support::CommandResult;
 using test_support::kSynth;
 using test_support::quote;
+using test_support::kTinyConfig;
 
 const std::string kMpiexec = AMYTISS_MPIEXEC;
-const std::string kTinyConfig = std::string(AMYTISS_SOURCE_DIR) + "/test/data/cli_tiny.yaml";
 // Root (CI) needs --allow-run-as-root; more ranks than cores need --oversubscribe.
 const std::string kMpiFlags = " --allow-run-as-root --oversubscribe";
 

@@ -22,9 +22,9 @@ namespace fs = std::filesystem;
 using test_support::CliTest;
 using test_support::CommandResult;
 using test_support::quote;
+using test_support::kTiny;
 
 const std::string kSourceDir = AMYTISS_SOURCE_DIR;
-const std::string kTiny = "--config " + quote(kSourceDir + "/test/data/cli_tiny.yaml") + " --quiet ";
 
 TEST_F(CliTest, AConfigurationThatIsADirectoryOrNeverEndsExitsTwo) {
   CommandResult result = synth("--config " + quote(directory_.string()));

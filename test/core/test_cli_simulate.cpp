@@ -21,10 +21,9 @@ namespace fs = std::filesystem;
 using test_support::CliTest;
 using test_support::CommandResult;
 using test_support::quote;
+using test_support::kTiny;
+using test_support::kTinyConfig;
 
-const std::string kSourceDir = AMYTISS_SOURCE_DIR;
-const std::string kTinyConfig = kSourceDir + "/test/data/cli_tiny.yaml";
-const std::string kTiny = "--config " + quote(kTinyConfig) + " --quiet ";
 constexpr double kPrintedRounding = 5e-7;  // six decimals
 
 // The number after `label` in the output, or NaN.
