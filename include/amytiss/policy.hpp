@@ -21,8 +21,9 @@ struct Policy {
   /// V_k for k = 0..horizon, k-major: values[k * states.size() + flat]. Probabilities in [0, 1].
   std::vector<double> values;
   /// Index (flat, into `inputs`) of u*(x, k) for k = 0..horizon-1: input_index[k * states.size()
-  /// + flat]. Ties: the lowest flat input index. Cells with a fixed role (target, avoid, unsafe)
-  /// hold input 0.
+  /// + flat]. Ties: the lowest flat input index. Cells with a fixed role: under the
+  /// abstraction the input a Free cell would get (the best one-step expectation of the next
+  /// values: a state in the cell's box may lie outside the set); with guarantee system input 0.
   std::vector<std::uint32_t> input_index;
   std::vector<CellRole> roles;
   /// What `values` and `upper_values` bound (docs/semantics.md). Abstraction: `values` are the
@@ -71,6 +72,9 @@ struct Policy {
   std::string describe(LookupStatus status, const double* state, std::size_t state_length,
                        unsigned step) const;
 };
+
+/// How every output labels a value of guarantee abstraction, beside the number.
+inline constexpr const char* kAbstractionValueLabel = "abstraction's value, not a guarantee for the real system";
 
 /// Summary of V_0 for logs: min, mean, max over Free cells, and how many cells have V_0 >= 0.5.
 struct ValueSummary {

@@ -208,9 +208,9 @@ void print_profile(const SynthesisReport& report) {
 
 void print_value_summary(const Policy& policy) {
   const ValueSummary summary = summarize_initial_values(policy);
-  std::printf("V_0 over %zu free cells: min %.6f, mean %.6f, max %.6f; %zu cells with V_0 >= 0.5\n",
-              summary.free_cells, summary.min, summary.mean, summary.max,
-              summary.cells_at_least_half);
+  std::printf("V_0 over %zu free cells: min %.6f, mean %.6f, max %.6f; %zu cells with V_0 >= 0.5%s\n",
+              summary.free_cells, summary.min, summary.mean, summary.max, summary.cells_at_least_half,
+              policy.guarantee == Guarantee::System ? "" : (std::string(" (") + kAbstractionValueLabel + ")").c_str());
   const BoundsSummary bounds = summarize_bounds(policy);
   auto range = [](const RangeSummary& r) {
     char text[96];
@@ -248,7 +248,8 @@ void print_values_at(const Policy& policy, const std::vector<double>& state) {
     std::printf("%s: certified lower bound %.6f (this policy), upper bound %.6f (any controller)%s\n", where.c_str(),
                 lower, upper, with_input.c_str());
   else
-    std::printf("%s: V_0 %.6f (the abstraction's value of its cell)%s\n", where.c_str(), lower, with_input.c_str());
+    std::printf("%s: V_0 %.6f (the %s, of its cell)%s\n", where.c_str(), lower, kAbstractionValueLabel,
+                with_input.c_str());
 }
 
 // The paper's bound is one interval Jacobian per box of cells, input and disturbance: at most

@@ -33,9 +33,8 @@ void print_comparison(const Policy& policy, const SimulationResult& result, doub
                       bool disturbed) {
   const double rate = result.rate(), error = result.standard_error();
   if (policy.guarantee != Guarantee::System) {
-    std::printf("simulation: abstraction's value V_0 %.6f (the finite abstraction's value of the cell, not a "
-                "guarantee for the real system): rate - V_0 = %s\n",
-                lower, gap_text(rate - lower, error).c_str());
+    std::printf("simulation: V_0 %.6f (the %s, of the cell): rate - V_0 = %s\n", lower, kAbstractionValueLabel,
+                gap_text(rate - lower, error).c_str());
     return;
   }
   const bool lower_ok = result.consistent_with_lower(lower, kConsistencyStandardErrors);

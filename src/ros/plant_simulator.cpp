@@ -298,7 +298,8 @@ int PlantSimulatorNode::run() {
     predicted = upper = 0.0;
   // With guarantee: system, V_0 is the certified lower bound for the continuous system.
   const bool certified = policy.guarantee == amytiss::Guarantee::System;
-  const std::string prediction = certified ? bounds_text(predicted, upper) : "predicted V_0 = " + format4(predicted);
+  const std::string abstraction_label = std::string(" (") + amytiss::kAbstractionValueLabel + ")";
+  const std::string prediction = certified ? bounds_text(predicted, upper) : "V_0 = " + format4(predicted) + abstraction_label;
   ROS_INFO("plant simulator: '%s', %d episodes from [%s], seed %d; %s", simulation.config.name.c_str(),
            settings_.episodes, join(initial_state).c_str(), settings_.seed, prediction.c_str());
   if (!wait_for_server(settings_.command_timeout_s * 4)) {
@@ -316,7 +317,7 @@ int PlantSimulatorNode::run() {
   const double standard_error =
       summary.episodes ? std::sqrt(summary.success_rate * (1 - summary.success_rate) / summary.episodes) : 0.0;
   const std::string at_start = certified ? prediction + " at the start state"
-                                         : "predicted V_0 at the start state = " + format4(predicted);
+                                         : "predicted V_0 at the start state = " + format4(predicted) + abstraction_label;
   ROS_INFO("plant simulator: empirical success rate %u/%u = %.3f (standard error %.3f); %s", summary.successes,
            summary.episodes, summary.success_rate, standard_error, at_start.c_str());
   ROS_INFO("plant simulator: %s", certified

@@ -48,9 +48,9 @@ TEST_F(CliTest, SimulatePrintsTheRateBesideTheAbstractionsValue) {
   ASSERT_TRUE(rate >= 0 && rate <= 1) << result.out;
   const double error = number_after(result.out, ", standard error ");
   EXPECT_NEAR(error, std::sqrt(rate * (1 - rate) / 400), kPrintedRounding) << result.out;
-  EXPECT_CONTAINS(result.out, "abstraction's value V_0 ");
-  EXPECT_CONTAINS(result.out, "not a guarantee for the real system");
-  const double value = number_after(result.out, "abstraction's value V_0 ");
+  EXPECT_CONTAINS(result.out, "simulation: V_0 ");
+  EXPECT_CONTAINS(result.out, "(the abstraction's value, not a guarantee for the real system, of the cell)");
+  const double value = number_after(result.out, "simulation: V_0 ");
   EXPECT_NEAR(number_after(result.out, "rate - V_0 = "), rate - value, kPrintedRounding) << result.out;
   EXPECT_CONTAINS(result.out, "simulation: ends: ");
 }

@@ -21,6 +21,9 @@ const std::string kConfigDir = std::string(AMYTISS_SOURCE_DIR) + "/config/";
 constexpr std::size_t kEpisodes = 300;
 constexpr double kStandardErrors = 4.0;
 constexpr std::uint64_t kSeed = 1;
+// How far a served value may exceed the simulated rate (beyond the standard errors) before it
+// overstates the real system.
+constexpr double kServedOverstatement = 0.01;
 
 struct Example {
   std::string config;
@@ -48,6 +51,26 @@ void expect_bounds_hold_the_rate(const Example& example) {
   }
   EXPECT_LE(lower, upper) << where;
   ::testing::Test::RecordProperty(example.config, where);
+}
+
+// The abstraction's value is no guarantee, but its controller must not make it a lie where the
+// grid is fine against the noise: in target cells (whose points lie in the target, not all their
+// states) it applies the input a Free cell would get, not input 0 (a jump off the grid).
+TEST(SimulatedSoundness, AbstractionsRobotControllerDoesNotOverstateFromItsLaunchStart) {
+  ComputeOverrides overrides;
+  overrides.guarantee = "abstraction";
+  const Config config = load_config_file(kConfigDir + "robot_reach_avoid.yaml", overrides);
+  const Abstraction abstraction = Abstraction::from_config(config);
+  SynthesisOptions options;
+  options.compute = config.compute;
+  const Policy policy = synthesize(abstraction, options, nullptr);
+  const std::vector<double> start = {-8.0, -8.0};
+  const auto cell = policy.states.cell_of(start.data());
+  ASSERT_TRUE(cell.has_value());
+  const SimulationResult result = simulate_cell(ClosedLoop(config, policy), *cell, kEpisodes, kSeed);
+  EXPECT_LE(policy.value(0, *cell),
+            result.rate() + kServedOverstatement + kStandardErrors * result.standard_error())
+      << "rate " << result.rate() << " +- " << result.standard_error();
 }
 
 TEST(SimulatedSoundness, RobotReachAvoidFromItsLaunchStart) {

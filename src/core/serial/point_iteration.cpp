@@ -12,6 +12,7 @@
 #include "amytiss/format.hpp"
 #include "amytiss/errors.hpp"
 #include "serial/game_graph.hpp"
+#include "serial/fixed_cell_inputs.hpp"
 #include "solve/interval_iteration.hpp"
 
 namespace amytiss::detail {
@@ -328,7 +329,9 @@ Policy run_abstraction_backward(const Abstraction& a, BellmanStep& step, StepRep
     ReferenceStep host(a);
     return solve_unbounded(a, step, host, run, report);
   };
-  return run_backward(a, {step, a.roles}, nullptr, unbounded, reporter);
+  Policy policy = run_backward(a, {step, a.roles}, nullptr, unbounded, reporter);
+  choose_fixed_cell_inputs(a, policy);
+  return policy;
 }
 
 }  // namespace amytiss::detail

@@ -1,0 +1,55 @@
+// Runs on the host with the serial step: fixed cells are few against the Free cells the engines
+// sweep, and the choice needs only one row per cell and input.
+#include "serial/fixed_cell_inputs.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "serial/reference_step.hpp"
+
+namespace amytiss::detail {
+namespace {
+
+std::uint32_t best_input(ReferenceStep& step, std::size_t cell, std::size_t inputs, const double* next) {
+  std::uint32_t best = 0;
+  double best_value = -1.0;
+  for (std::size_t u = 0; u < inputs; ++u) {
+    const double value = step.input_value(cell, u, next);
+    if (value > best_value) {
+      best_value = value;
+      best = std::uint32_t(u);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+void choose_fixed_cell_inputs(const Abstraction& a, Policy& policy) {
+  assert(policy.guarantee == Guarantee::Abstraction && policy.roles.size() == a.states.size());
+  std::vector<std::size_t> fixed;
+  for (std::size_t x = 0; x < policy.roles.size(); ++x)
+    if (policy.roles[x] != CellRole::Free) fixed.push_back(x);
+  if (fixed.empty() || a.inputs.size() <= 1) return;
+  const std::size_t cells = a.states.size(), inputs = a.inputs.size();
+  const unsigned rows = policy.stationary ? 1 : policy.horizon;
+  // One serial step per thread (its scratch is its own); the threads split the fixed cells.
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(fixed.size())));
+  std::vector<std::thread> team;
+  for (unsigned t = 0; t < threads; ++t)
+    team.emplace_back([&, t] {
+      ReferenceStep step(a);
+      for (unsigned k = 0; k < rows; ++k) {
+        // Stationary: rows 0 and 1 of values hold the same certified lower bound.
+        const double* next = &policy.values[std::size_t(policy.stationary ? 0 : k + 1) * cells];
+        for (std::size_t i = t; i < fixed.size(); i += threads)
+          policy.input_index[std::size_t(k) * cells + fixed[i]] = best_input(step, fixed[i], inputs, next);
+      }
+    });
+  for (std::thread& member : team) member.join();
+}
+
+}  // namespace amytiss::detail
