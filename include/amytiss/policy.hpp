@@ -21,9 +21,10 @@ struct Policy {
   /// V_k for k = 0..horizon, k-major: values[k * states.size() + flat]. Probabilities in [0, 1].
   std::vector<double> values;
   /// Index (flat, into `inputs`) of u*(x, k) for k = 0..horizon-1: input_index[k * states.size()
-  /// + flat]. Ties: the lowest flat input index. Cells with a fixed role: under the
-  /// abstraction the input a Free cell would get (the best one-step expectation of the next
-  /// values: a state in the cell's box may lie outside the set); with guarantee system input 0.
+  /// + flat]. Ties: the lowest flat input index. Target cells: under the abstraction the
+  /// input a Free cell would get (the best one-step expectation of the next values: a state in
+  /// the cell's box may lie outside the target); other fixed cells, and every fixed cell with
+  /// guarantee system, input 0.
   std::vector<std::uint32_t> input_index;
   std::vector<CellRole> roles;
   /// What `values` and `upper_values` bound (docs/semantics.md). Abstraction: `values` are the

@@ -537,7 +537,7 @@ TEST(Config, EveryTargetAndAvoidBoxPairMustShareNoGridPoint) {
 // Files written before sets could be unions carry the hash of their configuration: a single box
 // must keep its text (and so the hash) exactly.
 TEST(Config, SingleBoxSetsKeepTheirTextAndHash) {
-  const Config config = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/robot_reach_avoid.yaml");
+  const Config config = test_support::shipped_abstraction("robot_reach_avoid.yaml");
   const std::string text = to_yaml(config);
   EXPECT_NE(text.find("\n  target: {lb: [5, 5], ub: [7, 7]}\n  avoid: {lb: [-2, -2], ub: [2, 2]}\n"),
             std::string::npos) << text;

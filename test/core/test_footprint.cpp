@@ -222,7 +222,7 @@ TEST(FootprintConfig, BadObstaclesAreRefused) {
 
 // Configurations without the keys keep their canonical text and hash.
 TEST(FootprintConfig, CanonicalTextAndHash) {
-  const Config plain = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/robot_reach_avoid.yaml");
+  const Config plain = test_support::shipped_abstraction("robot_reach_avoid.yaml");
   EXPECT_EQ(to_yaml(plain).find("obstacles"), std::string::npos);
   EXPECT_EQ(to_yaml(plain).find("footprint"), std::string::npos);
   EXPECT_EQ(config_hash(plain), "de639acadc77740b");  // the hash this configuration has always had

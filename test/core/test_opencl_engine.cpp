@@ -249,7 +249,7 @@ TEST(OpenClEngine, ZeroVarianceDimensionAgreesWithReference) {
 // Float-stored masses of a row can sum to slightly more than 1; next to the target that used to
 // give values of 1 + 1e-8, which the policy file refuses. Coarse vehicle3d is such a case.
 TEST(OpenClEngine, ValuesStayProbabilitiesWhereRoundedRowsSumAboveOne) {
-  Config config = load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/vehicle3d.yaml");
+  Config config = test_support::shipped_abstraction("vehicle3d.yaml");
   config.states.eta = {1.0, 1.0, 0.4};
   config.spec.horizon = 4;
   const Abstraction a = Abstraction::from_config(config);
@@ -374,7 +374,10 @@ TEST(OpenClEngine, ReportsPhasesProgressAndMemory) {
   const Policy policy = detail::synthesize_opencl(a, options, &report);
   std::vector<std::string> names;
   for (const auto& phase : report.phases) names.push_back(phase.name);
-  const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0"};
+  const std::size_t targets = std::size_t(std::count(a.roles.begin(), a.roles.end(), CellRole::FixedOne));
+  ASSERT_GT(targets, 0u);
+  const std::vector<std::string> expected = {"device setup", "kernel build", "construction", "step 2", "step 1", "step 0",
+                                             "target cells' inputs (" + std::to_string(targets) + " cells, host)"};
   EXPECT_EQ(names, expected);
   EXPECT_GT(report.phases[2].pairs_per_second, 0);
   EXPECT_GT(report.phases[3].multiply_adds, 0);

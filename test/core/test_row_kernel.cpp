@@ -168,8 +168,7 @@ TEST(RowKernel, EveryRegisterBudgetGivesTheBitsOfOneEntryPerWorkItem) {
   // the last of 2 rows, stored without lines of rows (x'4's stage).
   const std::vector<Abstraction> problems = {
       from_yaml(traffic_yaml(0.4, 3)), from_yaml(test_support::long_rows_yaml()),
-      Abstraction::from_config(
-          load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/room_temperature_5d.yaml"))};
+      Abstraction::from_config(test_support::shipped_abstraction("room_temperature_5d.yaml"))};
   for (const Abstraction& a : problems) {
     const Policy entries = factored_policy(a, 1);
     for (unsigned width : {2u, 4u, 8u}) {

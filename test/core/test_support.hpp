@@ -160,6 +160,14 @@ inline std::filesystem::path fresh_test_directory(const std::string& prefix) {
   return directory;
 }
 
+/// A shipped configuration (config/<file>) read as the abstraction, whatever guarantee it states:
+/// the OpenCL engines' tests and the abstraction's hashes run on it.
+inline Config shipped_abstraction(const std::string& file) {
+  ComputeOverrides overrides;
+  overrides.guarantee = "abstraction";
+  return load_config_file(std::string(AMYTISS_SOURCE_DIR) + "/config/" + file, overrides);
+}
+
 /// The abstraction of a configuration given as YAML text (validated, like a configuration file).
 inline Abstraction from_yaml(const std::string& text) {
   return Abstraction::from_config(config_from_yaml(YAML::Load(text)));

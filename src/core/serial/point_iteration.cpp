@@ -12,7 +12,7 @@
 #include "amytiss/format.hpp"
 #include "amytiss/errors.hpp"
 #include "serial/game_graph.hpp"
-#include "serial/fixed_cell_inputs.hpp"
+#include "serial/target_cell_inputs.hpp"
 #include "solve/interval_iteration.hpp"
 
 namespace amytiss::detail {
@@ -330,7 +330,11 @@ Policy run_abstraction_backward(const Abstraction& a, BellmanStep& step, StepRep
     return solve_unbounded(a, step, host, run, report);
   };
   Policy policy = run_backward(a, {step, a.roles}, nullptr, unbounded, reporter);
-  choose_fixed_cell_inputs(a, policy);
+  const std::size_t targets = std::size_t(std::count(a.roles.begin(), a.roles.end(), CellRole::FixedOne));
+  const double seconds = choose_target_cell_inputs(a, policy);
+  if (seconds > 0)
+    reporter.phase(PhaseKind::Other, "target cells' inputs (" + std::to_string(targets) + " cells, host)", seconds, 0, 0,
+                   0, 0);
   return policy;
 }
 

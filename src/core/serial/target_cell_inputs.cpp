@@ -1,6 +1,6 @@
-// Runs on the host with the serial step: fixed cells are few against the Free cells the engines
+// Runs on the host with the serial step: target cells are few against the Free cells the engines
 // sweep, and the choice needs only one row per cell and input.
-#include "serial/fixed_cell_inputs.hpp"
+#include "serial/target_cell_inputs.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "amytiss/stopwatch.hpp"
 #include "serial/reference_step.hpp"
 
 namespace amytiss::detail {
@@ -28,16 +29,17 @@ std::uint32_t best_input(ReferenceStep& step, std::size_t cell, std::size_t inpu
 
 }  // namespace
 
-void choose_fixed_cell_inputs(const Abstraction& a, Policy& policy) {
+double choose_target_cell_inputs(const Abstraction& a, Policy& policy) {
   assert(policy.guarantee == Guarantee::Abstraction && policy.roles.size() == a.states.size());
-  std::vector<std::size_t> fixed;
+  const auto start = SteadyClock::now();
+  std::vector<std::size_t> targets;
   for (std::size_t x = 0; x < policy.roles.size(); ++x)
-    if (policy.roles[x] != CellRole::Free) fixed.push_back(x);
-  if (fixed.empty() || a.inputs.size() <= 1) return;
+    if (policy.roles[x] == CellRole::FixedOne) targets.push_back(x);
+  if (targets.empty() || a.inputs.size() <= 1) return 0.0;
   const std::size_t cells = a.states.size(), inputs = a.inputs.size();
   const unsigned rows = policy.stationary ? 1 : policy.horizon;
-  // One serial step per thread (its scratch is its own); the threads split the fixed cells.
-  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(fixed.size())));
+  // One serial step per thread (its scratch is its own); the threads split the target cells.
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(targets.size())));
   std::vector<std::thread> team;
   for (unsigned t = 0; t < threads; ++t)
     team.emplace_back([&, t] {
@@ -45,11 +47,12 @@ void choose_fixed_cell_inputs(const Abstraction& a, Policy& policy) {
       for (unsigned k = 0; k < rows; ++k) {
         // Stationary: rows 0 and 1 of values hold the same certified lower bound.
         const double* next = &policy.values[std::size_t(policy.stationary ? 0 : k + 1) * cells];
-        for (std::size_t i = t; i < fixed.size(); i += threads)
-          policy.input_index[std::size_t(k) * cells + fixed[i]] = best_input(step, fixed[i], inputs, next);
+        for (std::size_t i = t; i < targets.size(); i += threads)
+          policy.input_index[std::size_t(k) * cells + targets[i]] = best_input(step, targets[i], inputs, next);
       }
     });
   for (std::thread& member : team) member.join();
+  return seconds_since(start);
 }
 
 }  // namespace amytiss::detail
