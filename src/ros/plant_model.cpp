@@ -14,15 +14,9 @@ std::vector<double> PlantModel::step(const std::vector<double>& state, const std
   return plant_.step(state, input, random_);
 }
 
-StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state) {
-  if (state.size() != policy.states.dims()) return StateClass::OutsideGrid;
-  const auto cell = policy.states.cell_of(state.data());
-  if (!cell) return StateClass::OutsideGrid;
-  switch (policy.roles.at(*cell)) {
-    case amytiss::CellRole::FixedOne: return StateClass::Target;
-    case amytiss::CellRole::FixedZero: return StateClass::Unsafe;
-    default: return StateClass::Free;
-  }
+amytiss::SetVerdict classify_state(const amytiss::SpecSets& sets, const std::vector<double>& state) {
+  if (state.size() != sets.states().dims()) return amytiss::SetVerdict::OutsideGrid;
+  return sets.judge(state.data());
 }
 
 std::optional<amytiss::VehicleOutline> vehicle_outline(const amytiss::Config& config) {
@@ -74,19 +68,12 @@ std::string bounds_consistency_text(unsigned successes, unsigned episodes, doubl
   return text;
 }
 
-EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step) {
-  const std::string at = " at step " + std::to_string(step);
-  const bool safety = spec == amytiss::SpecType::Safety;
-  switch (state_class) {
-    case StateClass::Target: return {true, "reached the target" + at};
-    case StateClass::Unsafe:
-      return {false, safety ? "left the safe set" + at : "entered the avoid set" + at};
-    case StateClass::OutsideGrid: return {false, "left the grid" + at};
-    case StateClass::Free:
-    default:
-      if (safety) return {true, "stayed safe for all " + std::to_string(step) + " steps (horizon over)"};
-      return {false, "horizon over after " + std::to_string(step) + " steps without reaching the target"};
-  }
+EpisodeOutcome episode_outcome(amytiss::SpecType spec, amytiss::SetVerdict verdict, unsigned step) {
+  if (verdict != amytiss::SetVerdict::Undecided)
+    return {verdict == amytiss::SetVerdict::Target, amytiss::to_string(verdict) + " at step " + std::to_string(step)};
+  if (spec == amytiss::SpecType::Safety)
+    return {true, "stayed safe for all " + std::to_string(step) + " steps (horizon over)"};
+  return {false, "horizon over after " + std::to_string(step) + " steps without reaching the target"};
 }
 
 }  // namespace amytiss_ros

@@ -14,6 +14,7 @@
 #include "amytiss/model.hpp"
 #include "amytiss/plant.hpp"
 #include "amytiss/policy.hpp"
+#include "amytiss/spec_sets.hpp"
 
 namespace amytiss_ros {
 
@@ -32,10 +33,11 @@ class PlantModel {
   std::mt19937_64 random_;
 };
 
-/// Where a concrete state stands with respect to the specification, by its cell's role.
-enum class StateClass { Free, Target, Unsafe, OutsideGrid };
-/// Target: role FixedOne (target G); Unsafe: role FixedZero (avoid set A, or outside the safe set).
-StateClass classify_state(const amytiss::Policy& policy, const std::vector<double>& state);
+/// Where a concrete state stands, judged on the configuration's own sets (amytiss::SpecSets: the
+/// target and avoid boxes, the safe set, the car's body against the obstacles), not on the cells'
+/// roles: a state in a target cell's box need not lie in the target. A state of the wrong length
+/// is outside the grid.
+amytiss::SetVerdict classify_state(const amytiss::SpecSets& sets, const std::vector<double>& state);
 
 /// The outcome of one episode.
 struct EpisodeOutcome {
@@ -59,8 +61,8 @@ std::string consistency_text(unsigned successes, unsigned episodes, double predi
 /// binomial standard errors of a rate whose true value is that bound.
 std::string bounds_consistency_text(unsigned successes, unsigned episodes, double lower, double upper);
 
-/// Outcome of an episode that ended at `step` in a state of class `state_class` (for Free: the
+/// Outcome of an episode that ended at `step` in a state of verdict `verdict` (for Undecided: the
 /// horizon is over). Reach specs succeed on Target; safety succeeds when the horizon is over.
-EpisodeOutcome episode_outcome(amytiss::SpecType spec, StateClass state_class, unsigned step);
+EpisodeOutcome episode_outcome(amytiss::SpecType spec, amytiss::SetVerdict verdict, unsigned step);
 
 }  // namespace amytiss_ros

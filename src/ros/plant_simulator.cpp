@@ -117,6 +117,7 @@ struct PlantSimulatorNode::Simulation {
   amytiss::LoadedPolicy loaded;
   amytiss::Config config;
   std::optional<PlantModel> plant;
+  std::optional<amytiss::SpecSets> sets;  // what ends an episode: the configuration's own sets
   std::optional<amytiss::VehicleOutline> outline;
   const amytiss::Policy& policy() const { return loaded.policy; }
 };
@@ -191,9 +192,9 @@ EpisodeOutcome PlantSimulatorNode::run_episode(int episode, Simulation& simulati
   EpisodeOutcome outcome;
   for (unsigned step = 0;; ++step) {
     if (simulation.outline) car_publisher_.publish(make_car_marker(state, *simulation.outline, "map"));
-    const StateClass state_class = classify_state(policy, state);
-    if (state_class != StateClass::Free || step >= policy.horizon) {
-      outcome = episode_outcome(simulation.config.spec.type, state_class, step);
+    const amytiss::SetVerdict verdict = classify_state(*simulation.sets, state);
+    if (verdict != amytiss::SetVerdict::Undecided || step >= policy.horizon) {
+      outcome = episode_outcome(simulation.config.spec.type, verdict, step);
       rows.push_back(csv_row(episode, step, state, {}, policy.inputs.dims(), std::nan("")));
       break;
     }
@@ -279,6 +280,7 @@ int PlantSimulatorNode::run() {
     simulation.loaded = amytiss::read_policy_file(status->policy_file);
     simulation.config = stored_configuration(simulation.loaded);
     simulation.plant.emplace(simulation.config, static_cast<std::uint64_t>(settings_.seed));
+    simulation.sets.emplace(simulation.config);
   } catch (const std::exception& error) {
     ROS_ERROR("plant simulator: cannot simulate the policy %s: %s", status->policy_file.c_str(), error.what());
     return 1;

@@ -473,18 +473,22 @@ TEST(PlantModel, SameSeedSameTrajectoryAndNoiseHasTheConfiguredCovariance) {
 }
 
 TEST(Outcomes, TextsPerSpecification) {
-  using amytiss_ros::StateClass;
-  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Target, 12).description,
+  using amytiss::SetVerdict;
+  using amytiss::SpecType;
+  EXPECT_EQ(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::Target, 12).description,
             "reached the target at step 12");
-  EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Target, 12).success);
-  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Unsafe, 3).description,
+  EXPECT_TRUE(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::Target, 12).success);
+  EXPECT_EQ(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::Avoid, 3).description,
             "entered the avoid set at step 3");
-  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Unsafe, 3).description,
+  EXPECT_EQ(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::Obstacle, 4).description,
+            "touched an obstacle at step 4");
+  EXPECT_EQ(amytiss_ros::episode_outcome(SpecType::Safety, SetVerdict::Unsafe, 3).description,
             "left the safe set at step 3");
-  EXPECT_EQ(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::OutsideGrid, 5).description,
+  EXPECT_FALSE(amytiss_ros::episode_outcome(SpecType::Safety, SetVerdict::Unsafe, 3).success);
+  EXPECT_EQ(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::OutsideGrid, 5).description,
             "left the grid at step 5");
-  EXPECT_FALSE(amytiss_ros::episode_outcome(amytiss::SpecType::ReachAvoid, StateClass::Free, 14).success);
-  EXPECT_TRUE(amytiss_ros::episode_outcome(amytiss::SpecType::Safety, StateClass::Free, 8).success);
+  EXPECT_FALSE(amytiss_ros::episode_outcome(SpecType::ReachAvoid, SetVerdict::Undecided, 14).success);
+  EXPECT_TRUE(amytiss_ros::episode_outcome(SpecType::Safety, SetVerdict::Undecided, 8).success);
 }
 
 TEST(Outcomes, ConsistencyOfTheRateWithV0) {
@@ -507,16 +511,23 @@ TEST(Outcomes, ConsistencyOfTheRateWithTheCertifiedBounds) {
             "rate 1.0000" + limits + "[0.0000, 0.5578] over 20 episodes: NOT consistent");
 }
 
-TEST(Outcomes, ClassifyByCellRole) {
-  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(amytiss::load_config_file(kTinyConfig));
-  amytiss::Policy policy;
-  policy.states = abstraction.states;
-  policy.roles = abstraction.roles;
-  EXPECT_EQ(amytiss_ros::classify_state(policy, {3.5, 4.0}), amytiss_ros::StateClass::Target);
-  EXPECT_EQ(amytiss_ros::classify_state(policy, {0.2, -0.9}), amytiss_ros::StateClass::Unsafe);
-  EXPECT_EQ(amytiss_ros::classify_state(policy, {-4.0, -4.0}), amytiss_ros::StateClass::Free);
-  EXPECT_EQ(amytiss_ros::classify_state(policy, {-5.3, 0.0}), amytiss_ros::StateClass::OutsideGrid);
-  EXPECT_EQ(amytiss_ros::classify_state(policy, {0.0}), amytiss_ros::StateClass::OutsideGrid);
+// The configuration's own sets end an episode, not the cells' roles: (2.8, 3.5) lies in the
+// target cell of centre (3, 3.5) (its point is in the target [3, 4.5]^2), not in the target.
+TEST(Outcomes, ClassifyOnTheConfigurationsSets) {
+  const amytiss::Config config = amytiss::load_config_file(kTinyConfig);
+  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config);
+  const amytiss::SpecSets sets(config);
+  using amytiss::SetVerdict;
+  EXPECT_EQ(amytiss_ros::classify_state(sets, {3.5, 4.0}), SetVerdict::Target);
+  const std::vector<double> near_target = {2.8, 3.5};
+  const auto cell = abstraction.states.cell_of(near_target.data());
+  ASSERT_TRUE(cell.has_value());
+  ASSERT_EQ(abstraction.roles[*cell], amytiss::CellRole::FixedOne);
+  EXPECT_EQ(amytiss_ros::classify_state(sets, near_target), SetVerdict::Undecided);
+  EXPECT_EQ(amytiss_ros::classify_state(sets, {0.2, -0.9}), SetVerdict::Avoid);
+  EXPECT_EQ(amytiss_ros::classify_state(sets, {-4.0, -4.0}), SetVerdict::Undecided);
+  EXPECT_EQ(amytiss_ros::classify_state(sets, {-5.3, 0.0}), SetVerdict::OutsideGrid);
+  EXPECT_EQ(amytiss_ros::classify_state(sets, {0.0}), SetVerdict::OutsideGrid);
 }
 
 }  // namespace
