@@ -5,6 +5,7 @@
 // upper bound. The examples are those whose bounds take a few seconds at most on 2 cores.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,18 +31,35 @@ struct Example {
   std::vector<double> start;  // documented in the configuration or its launch file
 };
 
-void expect_bounds_hold_the_rate(const Example& example) {
+// The example synthesized under `guarantee`, and kEpisodes of its closed loop from its start's cell.
+struct Simulated {
+  Config config;
+  Policy policy;
+  std::size_t cell = 0;
+  SimulationResult result;
+};
+
+Simulated simulate_example(const Example& example, const std::string& guarantee) {
   ComputeOverrides overrides;
-  overrides.guarantee = "system";
-  const Config config = load_config_file(kConfigDir + example.config, overrides);
-  const Abstraction abstraction = Abstraction::from_config(config);
+  overrides.guarantee = guarantee;
+  Simulated simulated;
+  simulated.config = load_config_file(kConfigDir + example.config, overrides);
   SynthesisOptions options;
-  options.compute = config.compute;
-  const Policy policy = synthesize(abstraction, options, nullptr);
-  const auto cell = policy.states.cell_of(example.start.data());
-  ASSERT_TRUE(cell.has_value()) << example.config;
-  const double lower = policy.value(0, *cell), upper = policy.upper_value(0, *cell);
-  const SimulationResult result = simulate_cell(ClosedLoop(config, policy), *cell, kEpisodes, kSeed);
+  options.compute = simulated.config.compute;
+  simulated.policy = synthesize(Abstraction::from_config(simulated.config), options, nullptr);
+  const auto cell = simulated.policy.states.cell_of(example.start.data());
+  if (!cell) throw std::logic_error(example.config + ": the start lies outside the grid");
+  simulated.cell = *cell;
+  simulated.result = simulate_cell(ClosedLoop(simulated.config, simulated.policy), *cell, kEpisodes, kSeed);
+  return simulated;
+}
+
+void expect_bounds_hold_the_rate(const Example& example) {
+  const Simulated simulated = simulate_example(example, "system");
+  const Config& config = simulated.config;
+  const Policy& policy = simulated.policy;
+  const SimulationResult& result = simulated.result;
+  const double lower = policy.value(0, simulated.cell), upper = policy.upper_value(0, simulated.cell);
   const std::string where = example.config + ": lower " + std::to_string(lower) + ", upper " +
                             std::to_string(upper) + ", rate " + std::to_string(result.rate()) + " +- " +
                             std::to_string(result.standard_error());
@@ -57,18 +75,9 @@ void expect_bounds_hold_the_rate(const Example& example) {
 // grid is fine against the noise: in target cells (whose points lie in the target, not all their
 // states) it applies the input a Free cell would get, not input 0 (a jump off the grid).
 TEST(SimulatedSoundness, AbstractionsRobotControllerDoesNotOverstateFromItsLaunchStart) {
-  ComputeOverrides overrides;
-  overrides.guarantee = "abstraction";
-  const Config config = load_config_file(kConfigDir + "robot_reach_avoid.yaml", overrides);
-  const Abstraction abstraction = Abstraction::from_config(config);
-  SynthesisOptions options;
-  options.compute = config.compute;
-  const Policy policy = synthesize(abstraction, options, nullptr);
-  const std::vector<double> start = {-8.0, -8.0};
-  const auto cell = policy.states.cell_of(start.data());
-  ASSERT_TRUE(cell.has_value());
-  const SimulationResult result = simulate_cell(ClosedLoop(config, policy), *cell, kEpisodes, kSeed);
-  EXPECT_LE(policy.value(0, *cell),
+  const Simulated simulated = simulate_example({"robot_reach_avoid.yaml", {-8.0, -8.0}}, "abstraction");
+  const SimulationResult& result = simulated.result;
+  EXPECT_LE(simulated.policy.value(0, simulated.cell),
             result.rate() + kServedOverstatement + kStandardErrors * result.standard_error())
       << "rate " << result.rate() << " +- " << result.standard_error();
 }

@@ -186,7 +186,9 @@ TEST(SystemEngine, TheCertifiedCarsTargetIsWholeCellsAndTheParkingTargetsWholeCe
   EXPECT_GT(count_targets(parking_lower), 0u);
   EXPECT_LT(count_targets(parking_lower), count_targets(parking_abstraction));
   for (std::size_t x = 0; x < parking_lower.size(); ++x)
-    if (parking_lower[x] == CellRole::FixedOne) ASSERT_EQ(parking_abstraction[x], CellRole::FixedOne) << "cell " << x;
+    if (parking_lower[x] == CellRole::FixedOne) {
+      ASSERT_EQ(parking_abstraction[x], CellRole::FixedOne) << "cell " << x;
+    }
 }
 
 bool has_line(const std::vector<std::string>& lines, const std::string& text) {

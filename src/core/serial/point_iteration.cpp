@@ -330,11 +330,10 @@ Policy run_abstraction_backward(const Abstraction& a, BellmanStep& step, StepRep
     return solve_unbounded(a, step, host, run, report);
   };
   Policy policy = run_backward(a, {step, a.roles}, nullptr, unbounded, reporter);
-  const std::size_t targets = std::size_t(std::count(a.roles.begin(), a.roles.end(), CellRole::FixedOne));
-  const double seconds = choose_target_cell_inputs(a, policy);
-  if (seconds > 0)
-    reporter.phase(PhaseKind::Other, "target cells' inputs (" + std::to_string(targets) + " cells, host)", seconds, 0, 0,
-                   0, 0);
+  const TargetCellInputs targets = choose_target_cell_inputs(a, policy);
+  if (targets.seconds > 0)
+    reporter.phase(PhaseKind::Other, "target cells' inputs (" + std::to_string(targets.cells) + " cells, host)",
+                   targets.seconds, 0, 0, 0, 0);
   return policy;
 }
 

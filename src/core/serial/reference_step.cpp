@@ -83,6 +83,20 @@ double ReferenceStep::input_value(std::size_t cell, std::size_t input, const dou
   return worst;
 }
 
+std::uint32_t ReferenceStep::best_input(std::size_t cell, const double* in, double* value) {
+  std::uint32_t best = 0;
+  *value = -1.0;
+  for (std::size_t u = 0; u < input_points_.size(); ++u) {
+    const double candidate = input_value(cell, u, in);
+    // Strict '>': ties keep the lowest input index.
+    if (candidate > *value) {
+      *value = candidate;
+      best = static_cast<std::uint32_t>(u);
+    }
+  }
+  return best;
+}
+
 void ReferenceStep::apply(const double* in, double* out, std::uint32_t* chosen) {
   counted_ = 0;
   for (std::size_t cell = 0; cell < a_.states.size(); ++cell) {
@@ -93,14 +107,7 @@ void ReferenceStep::apply(const double* in, double* out, std::uint32_t* chosen) 
       continue;
     }
     double best_value = -1.0;
-    for (std::size_t u = 0; u < input_points_.size(); ++u) {
-      const double value = input_value(cell, u, in);
-      // Strict '>': ties keep the lowest input index.
-      if (value > best_value) {
-        best_value = value;
-        chosen[cell] = static_cast<std::uint32_t>(u);
-      }
-    }
+    chosen[cell] = best_input(cell, in, &best_value);
     // A sum of exact masses is at most 1, but its double rounding may exceed 1 by an ulp or so;
     // the value is a probability (and the policy file holds it to [0, 1]).
     out[cell] = std::min(best_value, 1.0);

@@ -21,6 +21,8 @@ class ReferenceStep : public BellmanStep {
   double expected(std::size_t cell, std::size_t input, std::size_t disturbance, const double* in);
   /// min over disturbances of expected().
   double input_value(std::size_t cell, std::size_t input, const double* in);
+  /// The input of largest input_value() for `cell` (ties: the lowest index); its value in *value.
+  std::uint32_t best_input(std::size_t cell, const double* in, double* value);
 
  private:
   const Abstraction& a_;

@@ -12,31 +12,15 @@
 #include "serial/reference_step.hpp"
 
 namespace amytiss::detail {
-namespace {
 
-std::uint32_t best_input(ReferenceStep& step, std::size_t cell, std::size_t inputs, const double* next) {
-  std::uint32_t best = 0;
-  double best_value = -1.0;
-  for (std::size_t u = 0; u < inputs; ++u) {
-    const double value = step.input_value(cell, u, next);
-    if (value > best_value) {
-      best_value = value;
-      best = std::uint32_t(u);
-    }
-  }
-  return best;
-}
-
-}  // namespace
-
-double choose_target_cell_inputs(const Abstraction& a, Policy& policy) {
+TargetCellInputs choose_target_cell_inputs(const Abstraction& a, Policy& policy) {
   assert(policy.guarantee == Guarantee::Abstraction && policy.roles.size() == a.states.size());
   const auto start = SteadyClock::now();
   std::vector<std::size_t> targets;
   for (std::size_t x = 0; x < policy.roles.size(); ++x)
     if (policy.roles[x] == CellRole::FixedOne) targets.push_back(x);
-  if (targets.empty() || a.inputs.size() <= 1) return 0.0;
-  const std::size_t cells = a.states.size(), inputs = a.inputs.size();
+  if (targets.empty() || a.inputs.size() <= 1) return {targets.size(), 0.0};
+  const std::size_t cells = a.states.size();
   const unsigned rows = policy.stationary ? 1 : policy.horizon;
   // One serial step per thread (its scratch is its own); the threads split the target cells.
   const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(targets.size())));
@@ -47,12 +31,13 @@ double choose_target_cell_inputs(const Abstraction& a, Policy& policy) {
       for (unsigned k = 0; k < rows; ++k) {
         // Stationary: rows 0 and 1 of values hold the same certified lower bound.
         const double* next = &policy.values[std::size_t(policy.stationary ? 0 : k + 1) * cells];
+        double value = 0.0;
         for (std::size_t i = t; i < targets.size(); i += threads)
-          policy.input_index[std::size_t(k) * cells + targets[i]] = best_input(step, targets[i], inputs, next);
+          policy.input_index[std::size_t(k) * cells + targets[i]] = step.best_input(targets[i], next, &value);
       }
     });
   for (std::thread& member : team) member.join();
-  return seconds_since(start);
+  return {targets.size(), seconds_since(start)};
 }
 
 }  // namespace amytiss::detail

@@ -1,5 +1,7 @@
 #pragma once
 // The inputs the abstraction's controller applies in its target cells.
+#include <cstddef>
+
 #include "amytiss/abstraction.hpp"
 #include "amytiss/policy.hpp"
 
@@ -11,7 +13,10 @@ namespace amytiss::detail {
 /// A target cell's point lies in the target, not all its states: input 0 would steer a real
 /// state that has not arrived anywhere. Avoid cells keep input 0 (they are many where a
 /// footprint meets obstacles, and the abstraction counts them as failed whatever the input).
-/// Returns the seconds it took.
-double choose_target_cell_inputs(const Abstraction& abstraction, Policy& policy);
+struct TargetCellInputs {
+  std::size_t cells = 0;  ///< target cells
+  double seconds = 0;     ///< 0 when nothing was chosen (no target cell, or one input)
+};
+TargetCellInputs choose_target_cell_inputs(const Abstraction& abstraction, Policy& policy);
 
 }  // namespace amytiss::detail
