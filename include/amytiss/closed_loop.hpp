@@ -7,6 +7,7 @@
 // over. Monte Carlo runs of it estimate the probability that the continuous-system bounds enclose.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ struct Episode {
   unsigned steps = 0;  ///< plant steps taken before the end
 };
 
+/// Called with every state an episode passes through, its step first: the start (step 0), each
+/// later state, and the state that ends the episode (state dims values).
+using StateObserver = std::function<void(unsigned step, const double* state)>;
+
 class ClosedLoop {
  public:
   /// `config` passed Config::validate() and `policy` was computed from it; the policy must outlive
@@ -44,7 +49,8 @@ class ClosedLoop {
              unsigned step_limit = kUnboundedStepLimit);
   /// One episode from `start` (state dims values), its draws from `random`. Const: episodes may
   /// run on several threads, each with its own generator.
-  Episode run(const std::vector<double>& start, std::mt19937_64& random) const;
+  /// With `observer`, it sees every state of the episode.
+  Episode run(const std::vector<double>& start, std::mt19937_64& random, const StateObserver& observer = {}) const;
   const Policy& policy() const { return policy_; }
   const SpecSets& sets() const { return sets_; }
 
@@ -79,6 +85,9 @@ struct SimulationResult {
 /// the seed and the count only, not on how many threads ran them (`threads`, 0: the host's).
 SimulationResult simulate_cell(const ClosedLoop& loop, std::size_t cell, std::size_t episodes, std::uint64_t seed,
                                unsigned threads = 0);
+
+/// A point drawn uniformly in the box of state cell `cell` (between its faces in every dimension).
+std::vector<double> point_in_cell(const Grid& states, std::size_t cell, std::mt19937_64& random);
 
 /// The seed of episode `episode` of a run with seed `seed` (SplitMix64 of both).
 std::uint64_t episode_seed(std::uint64_t seed, std::size_t episode);

@@ -129,6 +129,21 @@ struct SpecConfig {
   std::optional<Footprint> footprint;  ///< given exactly when `obstacles` is
 };
 
+/// `refine` (docs/refinement.md): rounds of continuous-system bounds, each on a grid whose cells
+/// are halved where the gap at the `at` states comes from, until the gap is reached or a budget
+/// ends. Guarantee system only.
+struct RefineConfig {
+  /// State points (state units, one value per state dimension) whose gap upper - lower at step 0
+  /// decides; empty: the mean gap over the free cells.
+  std::vector<std::vector<double>> at;
+  double gap = 0.05;             ///< stop when the gap is at most this, in (0, 1)
+  /// Most state cells a round's grid may have; 0: kDefaultStatesFactor times the first round's.
+  std::uint64_t max_states = 0;
+  unsigned max_rounds = 6;       ///< most rounds, the first (unrefined) one included, >= 1
+  double max_seconds = 600;      ///< wall seconds all rounds together may take (s), > 0
+  static constexpr std::uint64_t kDefaultStatesFactor = 16;
+};
+
 enum class DeviceKind { Auto, Cpu, Gpu, Reference };
 enum class TransitionStorage { Auto, Stored, OnTheFly };
 /// How the OpenCL engine computes the expected next values (docs/engine.md, "Two sweeps").
@@ -191,7 +206,8 @@ struct Config {
   GridSpec states;
   /// states.fit_sets: under guarantee system, insert a face at every face of the target, avoid,
   /// safe and obstacle boxes inside the grid's range (fitted_states(), grid_rules.hpp), so that no
-  /// cell straddles a set's boundary. Refused under guarantee abstraction.
+  /// cell straddles a set's boundary. Refused under guarantee abstraction. Default false, true
+  /// with `refine`.
   bool fit_sets = false;
   std::optional<GridSpec> inputs;        ///< absent: autonomous system (one empty input)
   std::optional<GridSpec> disturbances;  ///< absent: no adversary
@@ -204,6 +220,9 @@ struct Config {
   NoiseConfig noise;
   SpecConfig spec;
   Guarantee guarantee = Guarantee::Abstraction;
+  /// Gap-guided refinement of the state grid (guarantee system); absent: one synthesis on the
+  /// grid as given.
+  std::optional<RefineConfig> refine;
   ComputeConfig compute;
   OutputConfig output;
 

@@ -14,6 +14,26 @@ namespace amytiss {
 /// Outcome of a lookup; every non-Ok status comes with a message from describe().
 enum class LookupStatus { Ok, WrongDimension, NotFinite, OutsideGrid, StepBeyondHorizon };
 
+/// One round of `refine` (docs/refinement.md): the round's grid, its time and the gap it left.
+struct RefinementRound {
+  std::uint64_t states = 0;  ///< state cells of the round's grid
+  double seconds = 0;        ///< wall time of the round: its abstraction, bounds and split choice (s)
+  /// The round's gap: the largest upper - lower at step 0 over the `at` states, or without `at`
+  /// the mean over the free cells.
+  double gap = 0;
+  std::vector<double> lower, upper;  ///< the bounds at step 0 at each `at` state (empty without `at`)
+};
+
+/// The rounds of a refined synthesis; empty `rounds` for a policy computed on one grid.
+struct Refinement {
+  /// The `at` states (state units, one vector per state, as the configuration lists them) whose
+  /// bounds each round's lower and upper hold, in that order; empty without `at`.
+  std::vector<std::vector<double>> at;
+  std::vector<RefinementRound> rounds;
+  std::uint64_t served_round = 0;  ///< the round whose grid and bounds the policy holds (0-based)
+  std::string stop;                ///< why the rounds ended, a sentence
+};
+
 struct Policy {
   Grid states;
   Grid inputs;
@@ -50,6 +70,8 @@ struct Policy {
   /// Stationary only: whether `gap` reached the specification's tolerance. False: the bounds
   /// are sound but further apart than asked (the synthesis also said so in a Warning note).
   bool converged = true;
+  /// The rounds of `refine` that led to this grid (empty rounds without refine).
+  Refinement refinement;
   /// What computed it (device name or "reference") and the configuration's hash.
   std::string computed_by;
   std::string config_hash;

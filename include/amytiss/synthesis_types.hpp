@@ -26,6 +26,10 @@ struct Progress {
   std::string device;         ///< device name, or "reference"
   double elapsed_s = 0;       ///< seconds since synthesize() started
   double remaining_s = -1;    ///< estimate in seconds, < 0 when unknown
+  /// With `refine` (docs/refinement.md): the round running (1-based) and the most rounds; 0 and 0
+  /// for a synthesis on one grid. steps_done, elapsed_s and remaining_s are the round's.
+  unsigned round = 0;
+  unsigned max_rounds = 0;
   /// Share of the steps done, in percent (0 when the total is unknown; never above 100).
   double percent() const { return steps_total ? 100.0 * std::min(steps_done, steps_total) / steps_total : 0.0; }
 };
@@ -73,7 +77,8 @@ enum class NoteKind {
   Chunking,        ///< states split into chunks (allocation limits)
   DeviceMemory,    ///< device memory allocated
   KernelBuild,     ///< program built from source or loaded from the binary cache
-  Convergence      ///< unbounded specifications: end components, iterations, the gap reached
+  Convergence,     ///< unbounded specifications: end components, iterations, the gap reached
+  Refinement       ///< refine: each round's cells, gap and time, and why the rounds ended
 };
 std::string to_string(NoteSeverity severity);
 std::string to_string(NoteKind kind);

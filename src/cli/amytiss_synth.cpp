@@ -1,6 +1,7 @@
 // amytiss_synth: synthesizes a policy from a YAML configuration and writes it as an HDF5 policy
 // file. Usage and sample output: docs/cli.md.
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "amytiss/model_export.hpp"
 #include "amytiss/policy.hpp"
 #include "amytiss/policy_file.hpp"
+#include "amytiss/refinement.hpp"
 #include "amytiss/stopwatch.hpp"
 #include "mpi_session.hpp"
 #include "options.hpp"
@@ -111,7 +113,11 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   synthesis_options.progress = [quiet](const Progress& progress) { return print_progress(progress, quiet); };
   SynthesisReport report;
   const auto synthesis_start = SteadyClock::now();
-  const Policy policy = synthesize(abstraction, synthesis_options, &report);
+  // With refine the policy comes from the served round's grid, not the one printed above.
+  std::optional<RefinedSynthesis> refined;
+  if (config.refine) refined = synthesize_refined(config, synthesis_options, &report);
+  const Policy policy = refined ? std::move(refined->policy) : synthesize(abstraction, synthesis_options, &report);
+  const Abstraction& served = refined ? refined->abstraction : abstraction;
   const double synthesis_wall_seconds = seconds_since(synthesis_start);
   for (const auto& note : report.notes)
     std::printf("note: %s%s\n", note.severity == NoteSeverity::Warning ? "warning: " : "", note.text.c_str());
@@ -127,16 +133,18 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   std::printf("wall time:\n");
   std::printf("  %-24s %s\n", "config + abstraction", format_seconds(setup_seconds).c_str());
   print_phase_times(report);
-  std::printf("  %-24s %s\n", "synthesize() total", format_seconds(synthesis_wall_seconds).c_str());
+  std::printf("  %-24s %s\n", refined ? "refine, every round" : "synthesize() total",
+              format_seconds(synthesis_wall_seconds).c_str());
   std::printf("  %-24s %s\n", "file write", format_seconds(write_seconds).c_str());
   if (options.profile) print_profile(report);
+  print_refinement(policy);
   print_value_summary(policy);
   if (!options.at.empty()) print_values_at(policy, options.at);
   if (options.simulate && mpi.rank() == 0) print_simulation(config, policy, options.at, options.simulate, options.seed);
-  if (mpi.rank() == 0) print_apriori_error(abstraction);
+  if (mpi.rank() == 0) print_apriori_error(served);
   if (options.compare_reference) {
     const double engine_compute_seconds = report.phases.empty() ? synthesis_wall_seconds : compute_seconds(report);
-    compare_with_reference(abstraction, policy, synthesis_wall_seconds, engine_compute_seconds, quiet);
+    compare_with_reference(served, policy, synthesis_wall_seconds, engine_compute_seconds, quiet);
   }
   if (mpi.rank() == 0) std::printf("wrote %s\n", output.c_str());
   return 0;
@@ -162,6 +170,9 @@ int run(const Options& options, cli::MpiSession& mpi) {
   print_problem(options, config, abstraction);
   if (!options.export_format.empty()) return export_abstraction(options, abstraction);
   print_request(config, mpi);
+  // Each rank would decide its own rounds (the seconds' budget): one process refines.
+  if (config.refine && mpi.size() > 1)
+    throw UsageError("refine runs in one process: run amytiss_synth without mpirun (the bounds use the host's cores)");
 
   SynthesisOptions synthesis_options;
   synthesis_options.compute = config.compute;
@@ -169,6 +180,7 @@ int run(const Options& options, cli::MpiSession& mpi) {
   if (options.dry_run) {
     for (const std::string& line : describe_synthesis(abstraction, synthesis_options))
       std::printf("plan: %s\n", line.c_str());
+    if (config.refine) std::printf("plan: %s\n", describe_refine(*config.refine, abstraction.states.size()).c_str());
     std::printf("dry run: nothing computed, no file written\n");
     return 0;
   }

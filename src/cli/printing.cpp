@@ -92,11 +92,13 @@ bool print_progress(const Progress& progress, bool quiet) {
   if (quiet || !step_done) return true;
   if (progress.steps_total == 0) {  // unbounded: interval iterations, no fixed count; every 100th
     if (progress.steps_done % 100 != 0) return true;
+    if (progress.max_rounds) std::printf("  round %u/%u", progress.round, progress.max_rounds);
     std::printf("  iteration %u on %s, elapsed %s\n", progress.steps_done, progress.device.c_str(),
                 format_seconds(progress.elapsed_s).c_str());
     std::fflush(stdout);
     return true;
   }
+  if (progress.max_rounds) std::printf("  round %u/%u", progress.round, progress.max_rounds);
   std::printf("  step %u/%u  %5.1f%%  on %s, elapsed %s", progress.steps_done,
               progress.steps_total, progress.percent(), progress.device.c_str(),
               format_seconds(progress.elapsed_s).c_str());
@@ -250,6 +252,21 @@ void print_values_at(const Policy& policy, const std::vector<double>& state) {
   else
     std::printf("%s: V_0 %.6f (the %s, of its cell)%s\n", where.c_str(), lower, kAbstractionValueLabel,
                 with_input.c_str());
+}
+
+void print_refinement(const Policy& policy) {
+  const Refinement& refinement = policy.refinement;
+  if (refinement.rounds.empty()) return;
+  std::printf("refinement (%zu rounds):\n", refinement.rounds.size());
+  for (std::size_t r = 0; r < refinement.rounds.size(); ++r) {
+    const RefinementRound& round = refinement.rounds[r];
+    std::printf("  round %zu: %llu cells, gap %.6f, %s", r + 1, static_cast<unsigned long long>(round.states), round.gap,
+                format_seconds(round.seconds).c_str());
+    for (std::size_t i = 0; i < round.lower.size(); ++i)
+      std::printf("%s%.6f, %.6f", i ? "; " : ", lower, upper at the at states: ", round.lower[i], round.upper[i]);
+    std::printf("%s\n", r == refinement.served_round ? "  <- served" : "");
+  }
+  std::printf("  stopped: %s\n", refinement.stop.c_str());
 }
 
 // The paper's bound is one interval Jacobian per box of cells, input and disturbance: at most

@@ -38,6 +38,9 @@ std::string format_values(const std::vector<double>& values);
 /// The policy at `state`, step 0: the value of its cell (continuous-system bounds: the certified
 /// lower bound and the upper bound) and the input. The state must lie in the grid.
 void print_values_at(const Policy& policy, const std::vector<double>& state);
+/// With refine: one line per round (cells, gap, the bounds at the `at` states, seconds), the
+/// served round and why the rounds ended. Nothing for a policy of one grid.
+void print_refinement(const Policy& policy);
 /// The paper's a-priori error of the abstraction (apriori_error.hpp), its Jacobians bounded in number.
 void print_apriori_error(const Abstraction& abstraction);
 /// Runs the reference engine too and prints the speed-up and max |dV_0| (with upper bounds: the

@@ -93,6 +93,7 @@ std::string describe_progress(const amytiss::Progress& progress) {
   std::ostringstream text;
   text.setf(std::ios::fixed);
   text.precision(0);
+  if (progress.max_rounds) text << "refinement round " << progress.round << "/" << progress.max_rounds << ": ";
   text << amytiss::to_string(progress.phase) << " " << progress.percent() << "% (step " << progress.steps_done << "/"
        << progress.steps_total << ") on " << progress.device;
   text.precision(1);

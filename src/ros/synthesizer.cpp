@@ -10,10 +10,23 @@
 #include "amytiss/engine.hpp"
 #include "amytiss/errors.hpp"
 #include "amytiss/policy_file.hpp"
+#include "amytiss/refinement.hpp"
 #include "config_from_params.hpp"
 #include "conversions.hpp"
 
 namespace amytiss_ros {
+namespace {
+
+// One synthesis on the configuration's grid, or refine's rounds. The abstraction's set-up (the
+// footprint's test of the cells) reports progress and can be cancelled too.
+amytiss::Policy synthesize_policy(const amytiss::Config& config, const amytiss::SynthesisOptions& options,
+                                  amytiss::SynthesisReport& report) {
+  if (config.refine) return amytiss::synthesize_refined(config, options, &report).policy;
+  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config, options.progress);
+  return amytiss::synthesize(abstraction, options, &report);
+}
+
+}  // namespace
 
 std::string default_policy_path(const std::string& config_name) {
   std::string home;
@@ -214,10 +227,8 @@ void SynthesizerNode::synthesize_and_write(const amytiss::Config& config, const 
     on_progress(progress);
     return !cancelled();
   };
-  // The abstraction's set-up (the footprint's test of the cells) reports progress and can be cancelled too.
-  const amytiss::Abstraction abstraction = amytiss::Abstraction::from_config(config, options.progress);
   amytiss::SynthesisReport report;
-  const amytiss::Policy policy = amytiss::synthesize(abstraction, options, &report);
+  const amytiss::Policy policy = synthesize_policy(config, options, report);
   for (const auto& note : report.notes) {
     if (note.severity == amytiss::NoteSeverity::Warning)
       ROS_WARN("%s", note.text.c_str());

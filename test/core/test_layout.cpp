@@ -52,7 +52,8 @@ TEST(Layout, CoreHeadersSourcesAndCliIncludeNoRos) {
 int layer_of(const std::string& folder) {
   static const std::vector<std::pair<std::string, int>> kLayers = {
       {"common", 0},  {"model", 1}, {"config", 2}, {"factored", 3}, {"solve", 3},     {"serial", 4},
-      {"bounds", 4},  {"io", 4},    {"simulate", 4}, {"opencl", 5}, {"scale_out", 6}, {"", 7}};  // "": src/core itself (plan, engine)
+      {"bounds", 4},  {"io", 4},    {"simulate", 4}, {"opencl", 5}, {"scale_out", 6}, {"", 7},
+      {"refine", 8}};  // "": src/core itself (plan, engine); refine/ runs the engine in rounds
   for (const auto& [name, layer] : kLayers)
     if (folder == name) return layer;
   return -1;
@@ -71,7 +72,8 @@ const std::map<std::string, std::string>& public_header_folders() {
       {"footprint.hpp", "model"},   {"format.hpp", "common"},         {"grid.hpp", "model"},
       {"grid_rules.hpp", "model"},  {"interval.hpp", "model"},        {"model.hpp", "model"},
       {"model_export.hpp", "io"},   {"noise.hpp", "model"},           {"noise_sampler.hpp", "model"},
-      {"policy.hpp", "solve"},      {"policy_file.hpp", "io"},        {"resources.hpp", "common"},
+      {"policy.hpp", "solve"},      {"policy_file.hpp", "io"},        {"refinement.hpp", "refine"},
+      {"resources.hpp", "common"},
       {"roofline.hpp", "common"},   {"run_id.hpp", "common"},         {"scale_out.hpp", "common"},
       {"stopwatch.hpp", "common"},  {"synthesis_types.hpp", "common"}, {"version.hpp", "common"}};
   return folders;

@@ -94,7 +94,8 @@ const std::vector<std::pair<const char*, NoteKind>>& enum_names() {
       {"device_choice", NoteKind::DeviceChoice}, {"device_fallback", NoteKind::DeviceFallback},
       {"transitions", NoteKind::Transitions},    {"sweep", NoteKind::Sweep},
       {"chunking", NoteKind::Chunking},          {"device_memory", NoteKind::DeviceMemory},
-      {"kernel_build", NoteKind::KernelBuild},    {"convergence", NoteKind::Convergence}};
+      {"kernel_build", NoteKind::KernelBuild},    {"convergence", NoteKind::Convergence},
+      {"refinement", NoteKind::Refinement}};
   return names;
 }
 

@@ -13,6 +13,9 @@
 
 namespace amytiss::detail {
 
+/// The most points a grid may have: 2^32 - 1, its flat indices are uint32.
+inline constexpr std::uint64_t kMaxGridPoints = 4294967295ull;
+
 /// Throws ConfigError(key, "got <got>, expected <expected> (example: <example>)").
 [[noreturn]] inline void fail(const std::string& key, const std::string& got, const std::string& expected,
                               const std::string& example) {

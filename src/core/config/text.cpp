@@ -33,7 +33,7 @@ std::string states_yaml(const Config& config) {
   const GridSpec& grid = config.states;
   bool faced = false;
   for (std::size_t d = 0; d < grid.faces.size(); ++d) faced = faced || grid.has_faces(d);
-  if (!faced && !config.fit_sets) return grid_yaml(grid);
+  if (!faced && !config.fit_sets && !config.refine) return grid_yaml(grid);
   auto list = [](const std::vector<double>& values) {
     std::string text = "[";
     for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + (std::isnan(values[i]) ? "~" : format_number(values[i]));
@@ -45,7 +45,11 @@ std::string states_yaml(const Config& config) {
     for (std::size_t d = 0; d < grid.faces.size(); ++d) text += (d ? ", " : "") + (grid.has_faces(d) ? list(grid.faces[d]) : "~");
     text += "]";
   }
-  if (config.fit_sets) text += ", fit_sets: true";
+  // With refine, fit_sets is on unless the file turns it off.
+  if (config.fit_sets)
+    text += ", fit_sets: true";
+  else if (config.refine)
+    text += ", fit_sets: false";
   return text + "}";
 }
 
@@ -64,6 +68,15 @@ std::string footprint_yaml(const Footprint& footprint) {
   for (std::size_t i = 0; i < footprint.pose.size(); ++i) pose += (i ? ", " : "") + std::to_string(footprint.pose[i]);
   return "{pose: " + pose + "], length: " + format_number(footprint.length) + ", width: " +
          format_number(footprint.width) + ", rear_overhang: " + format_number(footprint.rear_overhang) + "}";
+}
+
+// Every key, defaults too: where the rounds stop is part of the result.
+std::string refine_yaml(const RefineConfig& refine) {
+  std::string at = "[";
+  for (std::size_t i = 0; i < refine.at.size(); ++i) at += (i ? ", " : "") + format_list(refine.at[i]);
+  return "{at: " + at + "], gap: " + format_number(refine.gap) + ", max_states: " +
+         std::to_string(refine.max_states) + ", max_rounds: " + std::to_string(refine.max_rounds) +
+         ", max_seconds: " + format_number(refine.max_seconds) + "}";
 }
 
 // compute and output: how the result is computed and stored.
@@ -148,6 +161,7 @@ std::string canonical_yaml(const Config& config, bool with_unhashed_sections) {
   if (config.spec.footprint) text += "  footprint: " + footprint_yaml(*config.spec.footprint) + "\n";
   // Left out when it is the default, so configurations without the key keep their text and hash.
   if (config.guarantee != Guarantee::Abstraction) text += "guarantee: " + to_string(config.guarantee) + "\n";
+  if (config.refine) text += "refine: " + refine_yaml(*config.refine) + "\n";
   // compute and output change how the result is computed or stored, not the result: no hash.
   if (with_unhashed_sections) text += unhashed_yaml(config);
   return text;

@@ -10,6 +10,7 @@
 #include "amytiss/grid_rules.hpp"
 #include "amytiss/model.hpp"
 #include "config/messages.hpp"
+#include "config/refine_section.hpp"
 
 namespace amytiss {
 namespace {
@@ -22,7 +23,7 @@ using detail::format_list;
 using detail::indexed;
 using detail::join;
 
-constexpr std::uint64_t kMaxGridPoints = 4294967295ull;          // 2^32 - 1: indices are uint32
+using detail::kMaxGridPoints;
 constexpr double kMaxPolicyBytes = 16.0 * 1024 * 1024 * 1024;   // 16 GiB
 constexpr unsigned kMaxHorizon = 1000000000;  // the policy arrays' 16 GiB limit is checked apart
 
@@ -343,6 +344,7 @@ void Config::validate() const {
                                                " points, at most 4294967295 (2^32 - 1) are supported; use a larger eta");
   }
   check_spec(spec, fitted);
+  detail::check_refine(*this, fitted);
   check_compute(compute);
   check_guarantee(*this);
   check_policy_size(state_points, spec, guarantee == Guarantee::System);

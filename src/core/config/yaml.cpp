@@ -12,6 +12,8 @@
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
 #include "config/messages.hpp"
+#include "config/refine_section.hpp"
+#include "config/yaml_read.hpp"
 
 namespace amytiss {
 namespace {
@@ -19,120 +21,21 @@ namespace {
 using detail::fail;
 using detail::indexed;
 using detail::join;
+using detail::add_once;
+using detail::check_keys;
+using detail::node_text;
+using detail::present;
+using detail::read_count;
+using detail::read_enum;
+using detail::read_flag;
+using detail::read_grid;
+using detail::read_number;
+using detail::read_number_list;
+using detail::read_string;
+using detail::read_string_list;
+using detail::required;
 
 const char* const kGridExample = "{lb: [-10, -10], ub: [10, 10], eta: [0.5, 0.5]}";
-
-std::string node_text(const YAML::Node& node) {
-  if (!node.IsDefined() || node.IsNull()) return "nothing";
-  if (node.IsScalar()) return node.Scalar();
-  if (node.IsSequence()) return "a list";
-  return "a map";
-}
-
-// " (lines 3 and 9)", or nothing for a tree not parsed from text (no positions).
-std::string lines_of(const YAML::Node& first, const YAML::Node& second) {
-  if (first.Mark().is_null() || second.Mark().is_null()) return "";
-  return " (lines " + std::to_string(first.Mark().line + 1) + " and " + std::to_string(second.Mark().line + 1) + ")";
-}
-
-// yaml-cpp keeps both entries of a repeated key and its lookup finds the first one: a second
-// `guarantee:` further down would be ignored without this check.
-void add_once(std::map<std::string, YAML::Node>& seen, const YAML::Node& name, const std::string& key) {
-  const auto [first, fresh] = seen.emplace(name.Scalar(), name);
-  if (!fresh)
-    throw ConfigError(key, "given twice" + lines_of(first->second, name) +
-                               ", expected each key once (remove one of them)");
-}
-
-std::string key_in(const std::string& key, const std::string& name) { return key.empty() ? name : key + "." + name; }
-
-void check_keys(const YAML::Node& node, const std::string& key, const std::vector<std::string>& allowed,
-                const std::string& example) {
-  if (!node.IsMap()) fail(key, node_text(node), "a map", example);
-  std::map<std::string, YAML::Node> seen;
-  for (const auto& entry : node) {
-    const std::string name = entry.first.Scalar();
-    bool known = false;
-    for (const auto& candidate : allowed) known = known || candidate == name;
-    if (!known)
-      throw ConfigError(key_in(key, name), "unknown key (valid keys" + (key.empty() ? std::string() : " of " + key) +
-                                               ": " + join(allowed) + ")");
-    add_once(seen, entry.first, key_in(key, name));
-  }
-}
-
-bool present(const YAML::Node& node) { return node.IsDefined() && !node.IsNull(); }
-
-double read_number(const YAML::Node& node, const std::string& key, const std::string& example) {
-  if (!node.IsScalar()) fail(key, node_text(node), "a number", example);
-  try {
-    return node.as<double>();
-  } catch (const YAML::Exception&) {
-    fail(key, "'" + node.Scalar() + "'", "a number", example);
-  }
-}
-
-// With `nulls`, null (~) stands for a dimension given by states.faces and reads as NaN.
-std::vector<double> read_number_list(const YAML::Node& node, const std::string& key, const std::string& example,
-                                     bool nulls = false) {
-  if (!node.IsSequence()) fail(key, node_text(node), "a list of numbers", example);
-  std::vector<double> values;
-  for (std::size_t i = 0; i < node.size(); ++i)
-    values.push_back(nulls && !present(node[i]) ? std::nan("") : read_number(node[i], indexed(key, i), example));
-  return values;
-}
-
-std::string read_string(const YAML::Node& node, const std::string& key, const std::string& example) {
-  if (!node.IsScalar()) fail(key, node_text(node), "a text value", example);
-  return node.Scalar();
-}
-
-// A count or an index: an integer that fits an unsigned 32-bit field. Whether it is in range is
-// validate()'s to judge; `expected` says what the key holds ("a positive integer").
-unsigned read_count(const YAML::Node& node, const std::string& key, const std::string& expected,
-                    const std::string& example) {
-  const double value = read_number(node, key, example);
-  if (!(value >= 0 && value == std::floor(value))) fail(key, node.Scalar(), expected, example);
-  if (value > double(UINT32_MAX)) fail(key, node.Scalar(), expected + " <= " + std::to_string(UINT32_MAX), example);
-  return static_cast<unsigned>(value);
-}
-
-std::vector<std::string> read_string_list(const YAML::Node& node, const std::string& key, const std::string& what,
-                                          const std::string& example) {
-  if (!node.IsSequence()) fail(key, node_text(node), what, example);
-  std::vector<std::string> values;
-  for (std::size_t i = 0; i < node.size(); ++i) values.push_back(read_string(node[i], indexed(key, i), example));
-  return values;
-}
-
-template <typename Enum>
-Enum read_enum(const YAML::Node& node, const std::string& key, const std::string& example) {
-  const std::string text = read_string(node, key, example);
-  if (const auto value = enum_from_name<Enum>(text)) return *value;
-  fail(key, "'" + text + "'", "one of " + enum_name_list<Enum>(), example);
-}
-
-const YAML::Node required(const YAML::Node& parent, const std::string& name, const std::string& key,
-                          const std::string& example) {
-  const YAML::Node node = parent[name];
-  if (!present(node)) throw ConfigError(key, "missing, expected a value (example: " + example + ")");
-  return node;
-}
-
-GridSpec read_grid(const YAML::Node& node, const std::string& key, const std::string& example) {
-  check_keys(node, key, {"lb", "ub", "eta"}, key + ": " + example);
-  GridSpec grid;
-  grid.lb = read_number_list(required(node, "lb", key + ".lb", example), key + ".lb", example);
-  grid.ub = read_number_list(required(node, "ub", key + ".ub", example), key + ".ub", example);
-  grid.eta = read_number_list(required(node, "eta", key + ".eta", example), key + ".eta", example);
-  return grid;
-}
-
-bool read_flag(const YAML::Node& node, const std::string& key, const std::string& example) {
-  const std::string text = node.IsScalar() ? node.Scalar() : node_text(node);
-  if (node.IsScalar() && (text == "true" || text == "false")) return text == "true";
-  fail(key, "'" + text + "'", "true or false", example);
-}
 
 // states: a grid whose dimensions may be given by their faces (lb, ub, eta null there or, when
 // every dimension has faces, left out), and fit_sets.
@@ -353,7 +256,7 @@ std::string read_config_text(const std::string& path) {
 Config read_config(const YAML::Node& root) {
   const char* const name_example = "name: robot_reach_avoid";
   check_keys(root, "", {"name", "states", "inputs", "disturbances", "constants", "dynamics", "model", "integrator",
-                        "noise", "spec", "guarantee", "compute", "output"},
+                        "noise", "spec", "guarantee", "refine", "compute", "output"},
              name_example);
   Config config;
   config.name = read_string(required(root, "name", "name", name_example), "name", name_example);
@@ -372,6 +275,11 @@ Config read_config(const YAML::Node& root) {
   config.spec = read_spec(required(root, "spec", "spec", "spec: {type: safety, horizon: 8}"));
   if (present(root["guarantee"]))
     config.guarantee = read_enum<Guarantee>(root["guarantee"], "guarantee", "guarantee: system");
+  if (present(root["refine"])) {
+    config.refine = detail::read_refine(root["refine"]);
+    // Refinement splits cells where the gap is; a cell straddling a set's face keeps a gap no split removes.
+    if (!present(root["states"]["fit_sets"])) config.fit_sets = true;
+  }
   if (present(root["compute"])) config.compute = read_compute(root["compute"]);
   if (present(root["output"])) config.output = read_output(root["output"]);
   return config;

@@ -150,6 +150,11 @@ void Hdf5Reader::read_numeric(hid_t dataset, const std::string& name, hid_t memo
     corrupt("dataset '" + name + "' (its checksum does not match or its data is missing)");
 }
 
+std::vector<hsize_t> Hdf5Reader::dataset_shape(const std::string& name) const {
+  Hdf5Handle dataset = open_dataset(name);
+  return shape_of(dataset.get(), name);
+}
+
 hsize_t Hdf5Reader::vector_length(const std::string& name) const {
   Hdf5Handle dataset = open_dataset(name);
   const std::vector<hsize_t> shape = shape_of(dataset.get(), name);

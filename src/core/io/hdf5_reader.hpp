@@ -57,6 +57,8 @@ class Hdf5Reader {
     bool is_signed;
   };
   ElementType element_type(const std::string& name) const;
+  /// The extents of a dataset (empty for a scalar).
+  std::vector<hsize_t> dataset_shape(const std::string& name) const;
   /// A numeric vector of any length.
   template <typename T>
   std::vector<T> vector_dataset(const std::string& name, H5T_class_t expected_class, hid_t memory_type) const {

@@ -1,6 +1,7 @@
 #include "io/policy_digest.hpp"
 
 #include "amytiss/format.hpp"
+#include "io/refinement_format.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -94,6 +95,8 @@ std::string policy_digest(const PolicyFileAttributes& attributes, const std::str
   for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = std::uint8_t(policy.roles[i]);
   digest.add(roles);
   if (policy.stationary || policy.guarantee == Guarantee::System) digest.add(upper_values);
+  // Present only in files of a refined synthesis: other files keep their digest.
+  if (!policy.refinement.rounds.empty()) digest.add(refinement_words(policy.refinement));
   return digest.hex();
 }
 

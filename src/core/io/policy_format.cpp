@@ -7,6 +7,7 @@
 #include "amytiss/errors.hpp"
 #include "io/policy_digest.hpp"
 #include "io/policy_storage.hpp"
+#include "io/refinement_format.hpp"
 
 namespace amytiss::detail {
 namespace {
@@ -298,6 +299,7 @@ void write_policy_contents(const Hdf5Writer& writer, const Policy& policy, const
                  Hdf5Writer::Filters::Compressed);
   if (policy.stationary || policy.guarantee == Guarantee::System)
     stored.write(writer, "/upper_values", upper_values_shape(policy), stored.upper_values());
+  write_refinement(writer, policy.refinement);
 }
 
 LoadedPolicy read_policy_contents(const Hdf5Reader& reader) {
@@ -312,6 +314,7 @@ LoadedPolicy read_policy_contents(const Hdf5Reader& reader) {
   policy.inputs = read_grid(reader, "/inputs");
   if (policy.states.dims() == 0) reader.fail("'/states' has no dimensions");
   read_cell_arrays(reader, policy);
+  policy.refinement = read_refinement(reader, policy.states.dims());
   const std::string digest = policy_digest(attributes, loaded.config_yaml, policy, policy.values, policy.upper_values);
   if (digest != stored_digest)
     reader.fail("corrupt: its contents give the digest " + digest + " but the file records " + stored_digest +

@@ -22,7 +22,8 @@ EpisodeEnd end_of(SetVerdict verdict) {
   }
 }
 
-// A point drawn uniformly in the box of `cell`: between its faces in every dimension.
+}  // namespace
+
 std::vector<double> point_in_cell(const Grid& states, std::size_t cell, std::mt19937_64& random) {
   std::vector<std::size_t> multi(states.dims());
   states.multi_index(cell, multi.data());
@@ -33,6 +34,8 @@ std::vector<double> point_in_cell(const Grid& states, std::size_t cell, std::mt1
   }
   return point;
 }
+
+namespace {
 
 // sqrt(p (1 - p) / n): the standard error of a rate over n trials whose true value is p.
 double binomial_spread(double p, std::size_t n) {
@@ -66,9 +69,10 @@ ClosedLoop::ClosedLoop(const Config& config, const Policy& policy, DisturbanceDr
                                 " input dimensions) are not the configuration's");
 }
 
-Episode ClosedLoop::run(const std::vector<double>& start, std::mt19937_64& random) const {
+Episode ClosedLoop::run(const std::vector<double>& start, std::mt19937_64& random, const StateObserver& observer) const {
   std::vector<double> state = start, next(state.size()), input(policy_.inputs.dims());
   for (unsigned step = 0;; ++step) {
+    if (observer) observer(step, state.data());
     const SetVerdict verdict = sets_.judge(state.data());
     if (verdict != SetVerdict::Undecided) return {verdict == SetVerdict::Target, end_of(verdict), step};
     if (policy_.stationary ? step >= step_limit_ : step >= policy_.horizon)
