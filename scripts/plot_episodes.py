@@ -13,7 +13,10 @@ point and yaw) the car's body is drawn at every step of every episode; with --sc
 scene (config/bmw_parking_scene.yaml: the bay, parked cars and kerbs, metres) is drawn under it,
 and every footprint is checked against the scene's obstacles (the result is printed and in the
 title). OUT2: V_0 over the x0/x1 slice of the grid, the other coordinates at the start state's
-cell. Needs python3-matplotlib, python3-h5py, python3-yaml (Debian).
+cell, with the sets outlined: for continuous-system bounds (guarantee: system) the lower bound
+(this policy) and the upper bound (any controller) side by side on one colour scale; for the
+abstraction its value, labelled as no guarantee for the real system. Needs python3-matplotlib,
+python3-h5py, python3-yaml (Debian).
 """
 import argparse
 import csv
@@ -42,12 +45,23 @@ def read_policy(path):
             faces = [np.asarray(f[f"states/faces/{d}"][()], dtype=float) for d in range(len(counts))]
         else:
             faces = [lb[d] + (np.arange(counts[d] + 1) - 0.5) * eta[d] for d in range(len(counts))]
+        upper = None
+        if "upper_values" in f:
+            upper = np.asarray(f["upper_values"][()])
+            # (horizon+1, n0, ...) for a bounded horizon, (n0, ...) for a stationary policy.
+            upper = upper[0] if upper.ndim == f["values"].ndim else upper
         return {
             "config": yaml.safe_load(config_text),
             "faces": faces,
             "counts": counts,
             "values": np.asarray(f["values"][0]),  # V_0, shape (n0, n1, ...)
+            "upper": upper,  # the upper bound at step 0 (guarantee: system, stationary), or None
+            "system": text_attribute(f.attrs.get("guarantee", "")) == "system",
         }
+
+
+def text_attribute(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
 
 
 def cell_index(faces, state):
@@ -160,6 +174,53 @@ def draw_sets(ax, policy, suffix=""):
         ax.set_ylim(y0 - 0.5, y1 + 0.5)
 
 
+def outline_sets(ax, policy):
+    """The specification's sets as outlines over a values picture (target green, avoid red, safe blue)."""
+    spec = policy["config"].get("spec", {}) or {}
+    for name, color in (("target", "tab:green"), ("avoid", "tab:red"), ("safe", "tab:blue")):
+        for index, box in enumerate(boxes_of(spec.get(name) or [])):
+            x, y, w, h = box_xy(box)
+            ax.add_patch(Rectangle((x, y), w, h, fill=False, ec=color, lw=1.5, label=name if index == 0 else None))
+
+
+def plot_values(policy, start, name, path):
+    """V_0 (system: lower and upper bound side by side) over the x0/x1 slice through the start's cell."""
+    faces = policy["faces"]
+    index = cell_index(faces, start)
+    panels = [("lower bound (this policy)", policy["values"]), ("upper bound (any controller)", policy["upper"])] \
+        if policy["system"] and policy["upper"] is not None else \
+        [("abstraction's value, not a guarantee for the real system", policy["values"])]
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 5.5 if len(faces) > 1 else 4), squeeze=False)
+    for ax, (label, values) in zip(axes[0], panels):
+        if values.ndim == 1:
+            ax.step(faces[0], np.append(values, values[-1]), where="post")
+            ax.set_xlabel("x0")
+            ax.set_ylabel("V_0")
+            ax.set_ylim(-0.02, 1.02)
+            ax.set_title(label, fontsize=9)
+            continue
+        plane = values[(slice(None), slice(None)) + tuple(index[2:])]
+        # pcolormesh draws each cell between its faces (cells of any widths).
+        image = ax.pcolormesh(faces[0], faces[1], plane.T, vmin=0.0, vmax=1.0, cmap="viridis", shading="flat")
+        outline_sets(ax, policy)
+        ax.plot(start[0], start[1], "r*", ms=12, label="start")
+        ax.set_xlim(faces[0][0], faces[0][-1])
+        ax.set_ylim(faces[1][0], faces[1][-1])
+        ax.set_xlabel("x0")
+        ax.set_ylabel("x1")
+        ax.legend(loc="best", fontsize=7)
+        ax.set_title(label, fontsize=9)
+        fig.colorbar(image, ax=ax, label="V_0 (probability)")
+    title = f"{name}: V_0 over x0/x1"
+    if len(faces) > 2:
+        point = [0.5 * (f[k] + f[k + 1]) for f, k in zip(faces, index)]
+        title += " at " + ", ".join(f"x{i} = {round(point[i], 9):g}" for i in range(2, len(faces)))
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--csv", required=True)
@@ -235,34 +296,7 @@ def main():
     fig.savefig(args.trajectories, dpi=120)
     plt.close(fig)
 
-    values = policy["values"]
-    faces = policy["faces"]
-    index = cell_index(faces, start)
-    if values.ndim == 1:
-        fig, ax = plt.subplots(figsize=(6.5, 4))
-        ax.plot(0.5 * (faces[0][:-1] + faces[0][1:]), values, "-o", ms=3)
-        ax.set_xlabel("x0")
-        ax.set_ylabel("V_0")
-    else:
-        slice_index = (slice(None), slice(None)) + tuple(index[2:])
-        plane = values[slice_index]
-        fig, ax = plt.subplots(figsize=(6.5, 5.5))
-        # pcolormesh draws each cell between its faces (cells of any widths).
-        image = ax.pcolormesh(faces[0], faces[1], plane.T, vmin=0.0, vmax=1.0, cmap="viridis", shading="flat")
-        fig.colorbar(image, ax=ax, label="V_0 (probability)")
-        ax.plot(start[0], start[1], "r*", ms=12, label="start")
-        ax.set_xlabel("x0")
-        ax.set_ylabel("x1")
-        ax.legend(loc="best", fontsize=8)
-        if len(faces) > 2:
-            point = [0.5 * (f[k] + f[k + 1]) for f, k in zip(faces, index)]
-            others = ", ".join(f"x{i} = {round(point[i], 9):g}" for i in range(2, len(faces)))
-            ax.set_title(f"{name}: V_0 over x0/x1 at {others}", fontsize=9)
-        else:
-            ax.set_title(f"{name}: V_0 over x0/x1")
-    fig.tight_layout()
-    fig.savefig(args.values, dpi=120)
-    plt.close(fig)
+    plot_values(policy, start, name, args.values)
     print(args.trajectories)
     print(args.values)
     return 0

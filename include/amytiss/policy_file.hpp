@@ -20,6 +20,9 @@
 // (= /values[1]) holds the certified lower bound. Continuous-system bounds (guarantee: system)
 // add the attribute guarantee = "system" and /upper_values, of shape (horizon+1, n0, n1, ...) for
 // a bounded horizon (stationary: (n0, n1, ...)): /values the lower, /upper_values the upper bounds.
+// A refined synthesis (`refine`, docs/refinement.md) adds /refinement/{states, seconds, gap, at,
+// lower, upper, served_round, stop}: its rounds; its grid is the served round's, /config the
+// configuration as given.
 // Every non-empty array is chunked with HDF5's Fletcher-32 checksum; the large ones are also
 // shuffled and deflated. The file is built in memory,
 // written to "<path>.tmp.<pid>", flushed and renamed, so a reader never sees half a file; a

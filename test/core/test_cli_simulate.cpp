@@ -1,10 +1,12 @@
 // amytiss_synth --simulate N --at X [--seed S]: the Monte Carlo rate of the served controller from
 // X's cell, printed beside the cell's values (abstraction) or bounds (guarantee: system), the same
-// for the same seed; and the refusals of counts, seeds and combinations that make no sense.
+// for the same seed; with refine, the rounds' table and the served round's bounds beside the rate;
+// and the refusals of counts, seeds and combinations that make no sense.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +23,7 @@ namespace fs = std::filesystem;
 using test_support::CliTest;
 using test_support::CommandResult;
 using test_support::quote;
+using test_support::read_file;
 using test_support::kTiny;
 using test_support::kTinyConfig;
 
@@ -68,6 +71,28 @@ TEST_F(CliTest, SimulateWithTheSystemGuaranteeComparesWithBothBounds) {
   EXPECT_NEAR(number_after(result.out, "simulation: certified lower bound "), lower, kPrintedRounding);
   EXPECT_NEAR(number_after(result.out, "simulation: upper bound "), upper, kPrintedRounding) << result.out;
   EXPECT_CONTAINS(result.out, "simulation: consistent with both bounds within 4 standard errors");
+}
+
+TEST_F(CliTest, RefinePrintsTheRoundsAndSimulatesTheServedRound) {
+  std::ofstream(path("refined.yaml")) << read_file(kTinyConfig) << "guarantee: system\n"
+                                      << "refine: {at: [[-2.2, 1.1]], gap: 0.001, max_rounds: 3}\n";
+  const CommandResult result =
+      synth("--config refined.yaml --quiet --output refined.h5 --at -2.2,1.1 --simulate 400");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "refinement (3 rounds):");
+  EXPECT_CONTAINS(result.out, "  round 3: ");
+  EXPECT_CONTAINS(result.out, "<- served");
+  EXPECT_CONTAINS(result.out, "  stopped: max_rounds 3 done");
+  EXPECT_CONTAINS(result.out, "note: refinement round 1: ");
+  const LoadedPolicy loaded = read_policy_file(path("refined.h5"));
+  ASSERT_EQ(loaded.policy.refinement.rounds.size(), 3u);
+  const RefinementRound& served = loaded.policy.refinement.rounds[loaded.policy.refinement.served_round];
+  // The simulation compares with the served round's bounds, the file's.
+  EXPECT_NEAR(number_after(result.out, "simulation: certified lower bound "), served.lower[0], kPrintedRounding);
+  EXPECT_EQ(loaded.policy.states.size(), served.states);
+  const CommandResult dry = synth("--config refined.yaml --quiet --dry-run");
+  ASSERT_EQ(0, dry.exit_code) << dry.out << dry.err;
+  EXPECT_CONTAINS(dry.out, "plan: refine: until the gap at 1 at state is at most 0.001; at most 3 rounds");
 }
 
 TEST_F(CliTest, SimulateGivesTheSameRateForTheSameSeed) {
