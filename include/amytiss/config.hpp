@@ -249,9 +249,12 @@ struct ComputeOverrides {
   /// abstraction | system: the top-level key `guarantee` (errors name key_prefix + "guarantee",
   /// or "guarantee" with the default prefix).
   std::string guarantee;
+  /// Replaces the configuration's refine section (the CLI's --refine); where the configuration
+  /// had none, states.fit_sets turns on, refine's default. Judged by validate() as `refine`.
+  std::optional<RefineConfig> refine;
 };
 
-/// Replaces the compute keys (and the guarantee) the overrides give. The configuration is read
+/// Replaces the compute keys (the guarantee, the refine section) the overrides give. The configuration is read
 /// but not yet validated: the caller validates after (config_from_yaml and load_config_file do).
 /// Throws ConfigError (key_prefix + key) for a device, transitions, sweep or guarantee text that
 /// names no value.

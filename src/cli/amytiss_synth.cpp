@@ -43,6 +43,11 @@ Config load_with_overrides(const Options& options) {
   overrides.platform = options.platform;
   if (!options.devices.empty()) overrides.devices = split_list(options.devices);
   overrides.guarantee = options.guarantee;
+  if (options.refine_gap > 0) {
+    overrides.refine = RefineConfig{};
+    overrides.refine->at = {options.at};
+    overrides.refine->gap = options.refine_gap;
+  }
   return load_config_file(options.config_path, overrides);
 }
 

@@ -31,6 +31,9 @@ const char* const kUsage =
     "                                     (gpu:0,gpu:1; cpu:0/1 splits the CPU device; docs/scale_out.md)\n"
     "  --guarantee abstraction|system     overrides guarantee (system: bounds for the continuous system)\n"
     "  --at X0,X1,...                     print the policy's values at this state (step 0) and its input\n"
+    "  --refine GAP                       with --at: refine the grid until upper - lower <= GAP at that\n"
+    "                                     state (refine: {at: [--at], gap: GAP}, guarantee: system;\n"
+    "                                     docs/refinement.md); replaces the configuration's refine\n"
     "  --simulate N                       with --at: N episodes of the continuous closed loop from uniform\n"
     "                                     points of that state's cell; prints the success rate beside the values\n"
     "  --seed S                           seed of --simulate (default 1; the same seed, the same rate)\n"
@@ -86,6 +89,15 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
   return value;
 }
 
+// --refine's gap: a number in (0, 1).
+double parse_gap(const std::string& text) {
+  char* end = nullptr;
+  const double gap = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(gap > 0 && gap < 1))
+    throw UsageError("--refine: got '" + text + "', expected a gap in (0, 1) (example: --at -8,-8 --refine 0.05)");
+  return gap;
+}
+
 // --simulate runs from --at's cell after a synthesis; --seed only seeds it.
 void check_simulation(const Options& options) {
   if (options.simulate && options.at.empty())
@@ -95,6 +107,9 @@ void check_simulation(const Options& options) {
   if (options.simulate && options.dry_run)
     throw UsageError("--simulate: got it with --dry-run, expected a synthesis to simulate: a dry run computes no "
                      "policy (example: --at -8,-8 --simulate 1000)");
+  if (options.refine_gap > 0 && options.at.empty())
+    throw UsageError("--refine: got it without --at, expected the state whose gap decides (example: --at -8,-8 "
+                     "--refine 0.05)");
   if (options.seed_given && !options.simulate)
     throw UsageError("--seed: got " + std::to_string(options.seed) +
                      " without --simulate, expected it with the episodes it seeds (example: --at -8,-8 --simulate "
@@ -107,6 +122,7 @@ void check_export_alone(const Options& options) {
   const std::pair<bool, const char*> synthesis_options[] = {{options.dry_run, "--dry-run"},
                                                             {!options.at.empty(), "--at"},
                                                             {options.simulate > 0, "--simulate"},
+                                                            {options.refine_gap > 0, "--refine"},
                                                             {!options.output.empty(), "--output"},
                                                             {options.profile, "--profile"},
                                                             {options.compare_reference, "--compare-reference"}};
@@ -138,6 +154,7 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--devices") options.devices = value();
     else if (arg == "--guarantee") options.guarantee = value();
     else if (arg == "--at") options.at = parse_state(value());
+    else if (arg == "--refine") options.refine_gap = parse_gap(value());
     else if (arg == "--simulate")
       options.simulate = parse_count("--simulate", value(), 1, kMaxSimulatedEpisodes, "1000");
     else if (arg == "--seed") {

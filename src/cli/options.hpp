@@ -30,6 +30,7 @@ struct Options {
   std::string devices;      // empty: the configuration's
   std::string guarantee;    // empty: the configuration's
   std::vector<double> at;   // a state whose values to print after the synthesis; empty: none
+  double refine_gap = 0;    // --refine: refine at --at's state until this gap; 0: the configuration's refine
   std::size_t simulate = 0;   // episodes of the closed loop from --at's cell; 0: none
   std::uint64_t seed = kDefaultSimulationSeed;  // of --simulate
   bool seed_given = false;

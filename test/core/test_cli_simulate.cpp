@@ -95,6 +95,27 @@ TEST_F(CliTest, RefinePrintsTheRoundsAndSimulatesTheServedRound) {
   EXPECT_CONTAINS(dry.out, "plan: refine: until the gap at 1 at state is at most 0.001; at most 3 rounds");
 }
 
+TEST_F(CliTest, RefineOptionRefinesAtTheAtState) {
+  const CommandResult result = synth(kTiny + "--guarantee system --output refined.h5 --at -2.2,1.1 --refine 0.2");
+  ASSERT_EQ(0, result.exit_code) << result.out << result.err;
+  EXPECT_CONTAINS(result.out, "refinement (");
+  const LoadedPolicy loaded = read_policy_file(path("refined.h5"));
+  const Config stored = read_stored_config(loaded.config_yaml);
+  ASSERT_TRUE(stored.refine);
+  EXPECT_EQ(stored.refine->gap, 0.2);
+  EXPECT_EQ(stored.refine->at, (std::vector<std::vector<double>>{{-2.2, 1.1}}));
+  EXPECT_TRUE(stored.fit_sets);
+  EXPECT_LE(loaded.policy.refinement.rounds[loaded.policy.refinement.served_round].gap, 0.2)
+      << loaded.policy.refinement.stop;
+  for (const std::string& wrong : {std::string("--guarantee system --refine 0.05"),
+                                   std::string("--guarantee system --at -2.2,1.1 --refine 1.5"),
+                                   std::string("--guarantee system --at -2.2,1.1 --refine x")}) {
+    const CommandResult refused = synth(kTiny + wrong);
+    EXPECT_EQ(2, refused.exit_code) << wrong << "\n" << refused.out << refused.err;
+    EXPECT_CONTAINS(refused.err, "--refine: got");
+  }
+}
+
 TEST_F(CliTest, SimulateGivesTheSameRateForTheSameSeed) {
   const std::string base = kTiny + "--output tiny.h5 --at 0.4,-2.6 --simulate 300";
   const CommandResult first = synth(base), second = synth(base + " --seed 1"), other = synth(base + " --seed 2");

@@ -7,8 +7,10 @@
 // - the refine section's reading and checks.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "amytiss/closed_loop.hpp"
@@ -136,6 +138,26 @@ TEST(Refinement, MaxRoundsAndMaxSecondsEndTheRounds) {
   const Refinement by_seconds = refine(refined_1d(rounds(20, ", max_seconds: 1.0e-6"))).policy.refinement;
   EXPECT_EQ(by_seconds.rounds.size(), 1u);  // the first round always runs
   EXPECT_NE(by_seconds.stop.find("max_seconds"), std::string::npos) << by_seconds.stop;
+}
+
+TEST(Refinement, ARoundThatOutrunsMaxSecondsIsCancelledAndTheEarlierOneServed) {
+  // The second round's first progress takes longer than the whole budget (the first round takes a few
+  // milliseconds, so the estimate lets the second start): its next progress cancels it.
+  constexpr auto kSlowProgress = std::chrono::milliseconds(1200);
+  bool slowed = false;
+  const RefinedSynthesis result = refine(refined_1d(rounds(5, ", max_seconds: 1.0")), [&](const Progress& progress) {
+    if (progress.round == 2 && !slowed) {
+      slowed = true;
+      std::this_thread::sleep_for(kSlowProgress);
+    }
+    return true;
+  });
+  const Refinement& refinement = result.policy.refinement;
+  ASSERT_TRUE(slowed);
+  EXPECT_EQ(refinement.rounds.size(), 1u);
+  EXPECT_EQ(refinement.served_round, 0u);
+  EXPECT_NE(refinement.stop.find("round 2 cancelled"), std::string::npos) << refinement.stop;
+  EXPECT_EQ(result.policy.states.size(), refinement.rounds[0].states);
 }
 
 TEST(Refinement, WithoutAtTheFreeCellsMeanGapFalls) {

@@ -1,4 +1,4 @@
-// The compute keys and the guarantee given beside a configuration (CLI options, the ROS ~device
+// The compute keys, the guarantee and the refine section given beside a configuration (CLI options, the ROS ~device
 // parameter) replace the configuration's before Config::validate() judges the whole.
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
@@ -32,6 +32,11 @@ void apply_overrides(Config& config, const ComputeOverrides& overrides) {
   if (!overrides.devices.empty()) compute.devices = overrides.devices;
   override_enum(config.guarantee, overrides.guarantee,
                 default_prefix_of(overrides) ? "guarantee" : overrides.key_prefix + "guarantee");
+  if (overrides.refine) {
+    // A configuration without refine had fit_sets at its default, which refine turns on.
+    if (!config.refine) config.fit_sets = true;
+    config.refine = overrides.refine;
+  }
 }
 
 }  // namespace amytiss

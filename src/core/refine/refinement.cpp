@@ -2,6 +2,7 @@
 // synthesize(), the gap measured at the `at` states, the next grid from split_choice.hpp.
 #include "amytiss/refinement.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <stdexcept>
 
 #include "amytiss/engine.hpp"
+#include "amytiss/errors.hpp"
 #include "amytiss/format.hpp"
 #include "amytiss/grid.hpp"
 #include "amytiss/grid_rules.hpp"
@@ -70,16 +72,32 @@ ProgressCallback round_progress(const ProgressCallback& progress, unsigned round
   };
 }
 
-// Why no further round runs after this one, or empty. `next` is the split choice for the next round.
-std::string stop_reason(const RefineConfig& refine, const RefinementRound& round, std::size_t rounds_done,
-                        const SplitChoice* next, double elapsed, double round_seconds) {
+// A round's seconds grow as its cells to a power: finer cells also widen each row's window in
+// noise cells. The power is the last two rounds' (clamped), kDefaultTimePower after one round.
+constexpr double kDefaultTimePower = 2.0;
+constexpr double kLeastTimePower = 1.0, kMostTimePower = 3.0;
+
+double next_round_seconds(const std::vector<RefinementRound>& before, const RefinementRound& round,
+                          std::uint64_t next_cells) {
+  double power = kDefaultTimePower;
+  if (!before.empty() && before.back().states < round.states && before.back().seconds > 0 && round.seconds > 0)
+    power = std::clamp(std::log(round.seconds / before.back().seconds) /
+                           std::log(double(round.states) / double(before.back().states)),
+                       kLeastTimePower, kMostTimePower);
+  return round.seconds * std::pow(double(next_cells) / double(round.states), power);
+}
+
+// Why no further round runs after this one, or empty. `next` is the split choice for the next
+// round, `before` the rounds before this one.
+std::string stop_reason(const RefineConfig& refine, const RefinementRound& round,
+                        const std::vector<RefinementRound>& before, const SplitChoice* next, double elapsed) {
+  const std::size_t rounds_done = before.size() + 1;
   if (round.gap <= refine.gap)
     return "gap " + probability_text(round.gap) + " <= " + format_number(refine.gap) + " reached";
   if (rounds_done >= refine.max_rounds)
     return "max_rounds " + std::to_string(refine.max_rounds) + " done, gap " + probability_text(round.gap) + " left";
   if (next->splits == 0) return next->why_none + ", gap " + probability_text(round.gap) + " left";
-  // A round's time grows about with its cells.
-  const double estimate = round_seconds * double(next->cells) / double(round.states);
+  const double estimate = next_round_seconds(before, round, next->cells);
   if (elapsed + estimate > refine.max_seconds)
     return "max_seconds " + format_number(refine.max_seconds) + ": the next round (" + std::to_string(next->cells) +
            " cells, about " + format_significant(estimate) + " s) would end after it, gap " + probability_text(round.gap) +
@@ -97,6 +115,43 @@ std::string describe_refine(const RefineConfig& refine, std::size_t first_cells)
          std::to_string(refine.max_rounds) + " rounds, " + std::to_string(max_cells(refine, first_cells)) +
          " cells, " + format_number(refine.max_seconds) + " s; the plan above is the first round's";
 }
+
+namespace {
+
+struct RoundOutcome {
+  Abstraction abstraction;
+  Policy policy;
+  SynthesisReport report;
+};
+
+// One round's abstraction and synthesis; nullopt when a round after the first outruns
+// max_seconds: it is cancelled (through its progress) and the rounds before it stand.
+std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& states, const SynthesisOptions& options,
+                                      std::size_t index, SteadyClock::time_point start) {
+  const RefineConfig& refine = *config.refine;
+  const ProgressCallback numbered = round_progress(options.progress, unsigned(index + 1), refine.max_rounds);
+  bool over_budget = false;
+  SynthesisOptions round_options = options;
+  round_options.progress = [&](const Progress& progress) {
+    if (index > 0 && seconds_since(start) > refine.max_seconds) {
+      over_budget = true;
+      return false;
+    }
+    return numbered ? numbered(progress) : true;
+  };
+  try {
+    const Config configuration = round_config(config, states);
+    configuration.validate();
+    RoundOutcome outcome{Abstraction::from_config(configuration, round_options.progress), {}, {}};
+    outcome.policy = synthesize(outcome.abstraction, round_options, &outcome.report);
+    return outcome;
+  } catch (const Cancelled&) {
+    if (!over_budget) throw;
+    return std::nullopt;
+  }
+}
+
+}  // namespace
 
 Config round_config(const Config& config, const GridSpec& states) {
   Config round = config;
@@ -120,13 +175,15 @@ RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions
   std::vector<EngineNote> round_notes;
   for (std::size_t index = 0;; ++index) {
     const auto round_start = SteadyClock::now();
-    SynthesisOptions round_options = options;
-    round_options.progress = round_progress(options.progress, unsigned(index + 1), refine.max_rounds);
-    const Config round_configuration = round_config(config, states);
-    round_configuration.validate();
-    Abstraction abstraction = Abstraction::from_config(round_configuration, round_options.progress);
-    SynthesisReport round_report;
-    Policy policy = synthesize(abstraction, round_options, &round_report);
+    std::optional<RoundOutcome> outcome = run_round(config, states, options, index, start);
+    if (!outcome) {
+      refinement.stop = "max_seconds " + format_number(refine.max_seconds) + ": round " + std::to_string(index + 1) +
+                        " cancelled after " + format_significant(seconds_since(round_start)) + " s";
+      break;
+    }
+    Abstraction& abstraction = outcome->abstraction;
+    Policy& policy = outcome->policy;
+    SynthesisReport& round_report = outcome->report;
     RefinementRound round = measure(policy, refine);
     std::optional<SplitChoice> next;
     if (round.gap > refine.gap && index + 1 < refine.max_rounds) {
@@ -135,7 +192,7 @@ RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions
     }
     round.seconds = seconds_since(round_start);
     const std::string stop =
-        stop_reason(refine, round, index + 1, next ? &*next : nullptr, seconds_since(start), round.seconds);
+        stop_reason(refine, round, refinement.rounds, next ? &*next : nullptr, seconds_since(start));
     round_notes.push_back({NoteSeverity::Info, NoteKind::Refinement, round_text(index, round, !refine.at.empty())});
     const bool best = !served || round.gap <= refinement.rounds[refinement.served_round].gap;
     refinement.rounds.push_back(round);
