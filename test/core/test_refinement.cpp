@@ -3,7 +3,8 @@
 //   (fine_recursion.hpp), in 2-d against Monte Carlo of the continuous closed loop;
 // - the gap at the `at` state does not grow over the rounds, and falls below the asked gap;
 // - each budget (max_rounds, max_states, max_seconds) ends the rounds and the stop says which;
-// - the progress carries the round; the policy file keeps the rounds (/refinement);
+// - a stationary policy (horizon: infinite) refines too; the progress carries the round; the policy
+//   file keeps the rounds (/refinement);
 // - the refine section's reading and checks.
 #include <gtest/gtest.h>
 
@@ -158,6 +159,21 @@ TEST(Refinement, ARoundThatOutrunsMaxSecondsIsCancelledAndTheEarlierOneServed) {
   EXPECT_EQ(refinement.served_round, 0u);
   EXPECT_NE(refinement.stop.find("round 2 cancelled"), std::string::npos) << refinement.stop;
   EXPECT_EQ(result.policy.states.size(), refinement.rounds[0].states);
+}
+
+TEST(Refinement, RefinesAStationaryPolicyOfAnUnboundedSpecification) {
+  std::string yaml = refined_1d(rounds(3));
+  yaml.replace(yaml.find("horizon: 5"), 10, "horizon: infinite");
+  const RefinedSynthesis result = refine(yaml);
+  const Refinement& refinement = result.policy.refinement;
+  EXPECT_TRUE(result.policy.stationary);
+  ASSERT_EQ(refinement.rounds.size(), 3u);
+  for (std::size_t r = 1; r < refinement.rounds.size(); ++r)
+    EXPECT_LE(refinement.rounds[r].gap, refinement.rounds[r - 1].gap) << "round " << r;
+  EXPECT_LT(refinement.rounds.back().gap, refinement.rounds.front().gap);
+  const double at = -0.55;
+  const std::size_t cell = *result.policy.states.cell_of(&at);
+  EXPECT_EQ(result.policy.upper_value(0, cell), refinement.rounds.back().upper[0]);
 }
 
 TEST(Refinement, WithoutAtTheFreeCellsMeanGapFalls) {

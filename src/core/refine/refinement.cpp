@@ -125,7 +125,8 @@ struct RoundOutcome {
 };
 
 // One round's abstraction and synthesis; nullopt when a round after the first outruns
-// max_seconds: it is cancelled (through its progress) and the rounds before it stand.
+// max_seconds, or its progress estimates it will: it is cancelled (through its progress) and the
+// rounds before it stand.
 std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& states, const SynthesisOptions& options,
                                       std::size_t index, SteadyClock::time_point start) {
   const RefineConfig& refine = *config.refine;
@@ -133,7 +134,9 @@ std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& stat
   bool over_budget = false;
   SynthesisOptions round_options = options;
   round_options.progress = [&](const Progress& progress) {
-    if (index > 0 && seconds_since(start) > refine.max_seconds) {
+    // Cancelled once past the budget, or once its own estimate of the time left says it will be.
+    const double ends_after = seconds_since(start) + std::max(0.0, progress.remaining_s);
+    if (index > 0 && ends_after > refine.max_seconds) {
       over_budget = true;
       return false;
     }
