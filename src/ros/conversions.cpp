@@ -86,6 +86,8 @@ amytiss::SynthesizeFeedback feedback_from_progress(const amytiss::Progress& prog
   feedback.steps_total = progress.steps_total;
   feedback.device = progress.device;
   feedback.remaining_s = progress.remaining_s;
+  feedback.round = progress.round;
+  feedback.max_rounds = progress.max_rounds;
   return feedback;
 }
 

@@ -350,6 +350,16 @@ TEST(ProgressConversions, FeedbackCarriesEveryField) {
   EXPECT_EQ(feedback.remaining_s, 2.0);
   EXPECT_EQ(amytiss_ros::describe_progress(progress),
             "synthesis 44% (step 7/16) on reference, 1.5 s elapsed, about 2.0 s left");
+  EXPECT_EQ(feedback.round, 0u);
+  EXPECT_EQ(feedback.max_rounds, 0u);
+  // A round of refine: the feedback and the text name it.
+  progress.round = 2;
+  progress.max_rounds = 6;
+  const amytiss::SynthesizeFeedback refined = amytiss_ros::feedback_from_progress(progress);
+  EXPECT_EQ(refined.round, 2u);
+  EXPECT_EQ(refined.max_rounds, 6u);
+  EXPECT_EQ(amytiss_ros::describe_progress(progress),
+            "refinement round 2/6: synthesis 44% (step 7/16) on reference, 1.5 s elapsed, about 2.0 s left");
 }
 
 TEST(Markers, GridBoundsTargetAndAvoid) {
