@@ -44,5 +44,8 @@ constexpr double kFitFaceSlack = 1e-9;
 /// strictly inside the grid's range (a dimension without an inserted face stays as it was). The
 /// configuration's grid must be valid (Config::validate() checks it first).
 GridSpec fitted_states(const Config& config);
+/// Gives dimension `dim` of `spec` its cell `faces` (n + 1 strictly increasing values, state
+/// units): faces[dim] set, lb, ub and eta NaN there, as states.faces describes such a dimension.
+void set_dimension_faces(GridSpec& spec, std::size_t dim, std::vector<double> faces);
 
 }  // namespace amytiss

@@ -63,13 +63,16 @@ GridSpec fitted_states(const Config& config) {
   const std::vector<std::vector<double>> candidates = set_faces(config.spec, grid.dims());
   for (std::size_t d = 0; d < grid.dims(); ++d) {
     std::vector<double> faces = grid.faces(d);
-    if (!insert_faces(faces, candidates[d])) continue;
-    spec.faces.resize(grid.dims());
-    spec.faces[d] = std::move(faces);
-    constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
-    spec.lb[d] = spec.ub[d] = spec.eta[d] = kNotGiven;
+    if (insert_faces(faces, candidates[d])) set_dimension_faces(spec, d, std::move(faces));
   }
   return spec;
+}
+
+void set_dimension_faces(GridSpec& spec, std::size_t dim, std::vector<double> faces) {
+  spec.faces.resize(spec.lb.size());
+  spec.faces[dim] = std::move(faces);
+  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+  spec.lb[dim] = spec.ub[dim] = spec.eta[dim] = kNotGiven;
 }
 
 }  // namespace amytiss

@@ -191,7 +191,7 @@ RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions
     std::optional<SplitChoice> next;
     if (round.gap > refine.gap && index + 1 < refine.max_rounds) {
       const auto gap = detail::attribute_gap(abstraction, policy, refine.at, detail::kAttributionEpisodes, index + 1);
-      next = detail::choose_splits(states, policy.states, *abstraction.noise, gap, cells_budget);
+      next = detail::choose_splits(states, *abstraction.noise, gap, cells_budget);
     }
     round.seconds = seconds_since(round_start);
     const std::string stop =

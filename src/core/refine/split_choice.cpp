@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <random>
 
 #include "amytiss/closed_loop.hpp"
 #include "amytiss/format.hpp"
+#include "amytiss/grid_rules.hpp"
 #include "bounds/lattice.hpp"
 #include "common/parallel_for.hpp"
 
@@ -102,9 +102,7 @@ GridSpec halved(const GridSpec& current, const Grid& grid, const std::vector<std
       if (marked[d][k]) refined.push_back(faces[k] + (faces[k + 1] - faces[k]) / 2);
     }
     refined.push_back(faces.back());
-    next.faces.resize(grid.dims());
-    next.faces[d] = std::move(refined);
-    next.lb[d] = next.ub[d] = next.eta[d] = std::numeric_limits<double>::quiet_NaN();
+    set_dimension_faces(next, d, std::move(refined));
   }
   return next;
 }
@@ -142,9 +140,10 @@ GapTable attribute_gap(const Abstraction& abstraction, const Policy& policy, con
   return table;
 }
 
-SplitChoice choose_splits(const GridSpec& current, const Grid& grid, const NoiseModel& noise, const GapTable& gap,
+SplitChoice choose_splits(const GridSpec& current, const NoiseModel& noise, const GapTable& gap,
                           std::uint64_t max_cells) {
   SplitChoice choice;
+  const Grid grid(current);
   const std::vector<Candidate> ranked = candidates(grid, noise, gap);
   if (ranked.empty()) {
     choice.why_none = "no interval to halve: no cell of a noisy state dimension adds to the gap (it comes from "

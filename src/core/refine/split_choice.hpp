@@ -42,8 +42,8 @@ struct SplitChoice {
 /// Halves the intervals of the most weighed gap, gap[d][k] times the interval's width over the
 /// noise's scale along d (noise-free dimensions are not split: their cells follow the lattice),
 /// until kCoveredShare of the weighed gap is covered or the next halving would take the grid
-/// beyond min(max_cells, kRoundGrowth times its cells). `grid` is `current`'s.
-SplitChoice choose_splits(const GridSpec& current, const Grid& grid, const NoiseModel& noise,
-                          const std::vector<std::vector<double>>& gap, std::uint64_t max_cells);
+/// beyond min(max_cells, kRoundGrowth times its cells).
+SplitChoice choose_splits(const GridSpec& current, const NoiseModel& noise, const std::vector<std::vector<double>>& gap,
+                          std::uint64_t max_cells);
 
 }  // namespace amytiss::detail
