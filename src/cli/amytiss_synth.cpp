@@ -120,7 +120,7 @@ int synthesize_and_write(const Options& options, const Config& config, const Abs
   const auto synthesis_start = SteadyClock::now();
   // With refine the policy comes from the served round's grid, not the one printed above.
   std::optional<RefinedSynthesis> refined;
-  if (config.refine) refined = synthesize_refined(config, synthesis_options, &report);
+  if (config.refine) refined = synthesize_refined(config, synthesis_options, &report, &abstraction);
   const Policy policy = refined ? std::move(refined->policy) : synthesize(abstraction, synthesis_options, &report);
   const Abstraction& served = refined ? refined->abstraction : abstraction;
   const double synthesis_wall_seconds = seconds_since(synthesis_start);
@@ -169,7 +169,8 @@ int run(const Options& options, cli::MpiSession& mpi) {
   const auto setup_start = SteadyClock::now();
   const Config config = load_with_overrides(options);
   check_output_option(options, config);
-  const Abstraction abstraction = Abstraction::from_config(config);
+  // With refine, the first round's abstraction: printed, planned and handed to the rounds.
+  const Abstraction abstraction = Abstraction::from_config(config.refine ? first_round_config(config) : config);
   const double setup_seconds = seconds_since(setup_start);
   check_state_option(options, abstraction.states);
   print_problem(options, config, abstraction);

@@ -1,5 +1,6 @@
-// The compute keys, the guarantee and the refine section given beside a configuration (CLI options, the ROS ~device
-// parameter) replace the configuration's before Config::validate() judges the whole.
+// The compute keys, the guarantee and the refine section given beside a configuration (CLI
+// options, the ROS ~device parameter) replace the configuration's before Config::validate()
+// judges the whole.
 #include "amytiss/config.hpp"
 #include "amytiss/enum_names.hpp"
 #include "config/messages.hpp"

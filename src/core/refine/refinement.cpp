@@ -105,19 +105,6 @@ std::string stop_reason(const RefineConfig& refine, const RefinementRound& round
   return {};
 }
 
-}  // namespace
-
-std::string describe_refine(const RefineConfig& refine, std::size_t first_cells) {
-  const std::string where = refine.at.empty() ? "the free cells' mean gap"
-                                              : "the gap at " + std::to_string(refine.at.size()) + " at state" +
-                                                    (refine.at.size() == 1 ? "" : "s");
-  return "refine: until " + where + " is at most " + format_number(refine.gap) + "; at most " +
-         std::to_string(refine.max_rounds) + " rounds, " + std::to_string(max_cells(refine, first_cells)) +
-         " cells, " + format_number(refine.max_seconds) + " s; the plan above is the first round's";
-}
-
-namespace {
-
 struct RoundOutcome {
   Abstraction abstraction;
   Policy policy;
@@ -128,7 +115,7 @@ struct RoundOutcome {
 // max_seconds, or its progress estimates it will: it is cancelled (through its progress) and the
 // rounds before it stand.
 std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& states, const SynthesisOptions& options,
-                                      std::size_t index, SteadyClock::time_point start) {
+                                      std::size_t index, SteadyClock::time_point start, const Abstraction* built) {
   const RefineConfig& refine = *config.refine;
   const ProgressCallback numbered = round_progress(options.progress, unsigned(index + 1), refine.max_rounds);
   bool over_budget = false;
@@ -143,9 +130,14 @@ std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& stat
     return numbered ? numbered(progress) : true;
   };
   try {
-    const Config configuration = round_config(config, states);
-    configuration.validate();
-    RoundOutcome outcome{Abstraction::from_config(configuration, round_options.progress), {}, {}};
+    RoundOutcome outcome;
+    if (built) {
+      outcome.abstraction = *built;
+    } else {
+      const Config configuration = round_config(config, states);
+      configuration.validate();
+      outcome.abstraction = Abstraction::from_config(configuration, round_options.progress);
+    }
     outcome.policy = synthesize(outcome.abstraction, round_options, &outcome.report);
     return outcome;
   } catch (const Cancelled&) {
@@ -156,6 +148,15 @@ std::optional<RoundOutcome> run_round(const Config& config, const GridSpec& stat
 
 }  // namespace
 
+std::string describe_refine(const RefineConfig& refine, std::size_t first_cells) {
+  const std::string where = refine.at.empty() ? "the free cells' mean gap"
+                                              : "the gap at " + std::to_string(refine.at.size()) + " at state" +
+                                                    (refine.at.size() == 1 ? "" : "s");
+  return "refine: until " + where + " is at most " + format_number(refine.gap) + "; at most " +
+         std::to_string(refine.max_rounds) + " rounds, " + std::to_string(max_cells(refine, first_cells)) +
+         " cells, " + format_number(refine.max_seconds) + " s; the plan above is the first round's";
+}
+
 Config round_config(const Config& config, const GridSpec& states) {
   Config round = config;
   round.states = states;
@@ -164,13 +165,18 @@ Config round_config(const Config& config, const GridSpec& states) {
   return round;
 }
 
-RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions& options, SynthesisReport* report) {
+Config first_round_config(const Config& config) { return round_config(config, fitted_states(config)); }
+
+RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions& options, SynthesisReport* report,
+                                    const Abstraction* first_round) {
   if (!config.refine) throw std::logic_error("synthesize_refined: the configuration has no refine section");
   const RefineConfig& refine = *config.refine;
   SynthesisReport local;
   SynthesisReport& out = report ? *report : local;
   const auto start = SteadyClock::now();
   GridSpec states = fitted_states(config);
+  if (first_round && first_round->states.size() != Grid(states).size())
+    throw std::logic_error("synthesize_refined: the first round's abstraction is not first_round_config()'s");
   const std::uint64_t cells_budget = max_cells(refine, Grid(states).size());
   Refinement refinement;
   refinement.at = refine.at;
@@ -178,7 +184,8 @@ RefinedSynthesis synthesize_refined(const Config& config, const SynthesisOptions
   std::vector<EngineNote> round_notes;
   for (std::size_t index = 0;; ++index) {
     const auto round_start = SteadyClock::now();
-    std::optional<RoundOutcome> outcome = run_round(config, states, options, index, start);
+    std::optional<RoundOutcome> outcome =
+        run_round(config, states, options, index, start, index == 0 ? first_round : nullptr);
     if (!outcome) {
       refinement.stop = "max_seconds " + format_number(refine.max_seconds) + ": round " + std::to_string(index + 1) +
                         " cancelled after " + format_significant(seconds_since(round_start)) + " s";
