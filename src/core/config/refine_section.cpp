@@ -1,5 +1,6 @@
 // The `refine` section (docs/refinement.md): reading it from YAML and Config::validate()'s checks.
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "amytiss/config.hpp"
@@ -45,13 +46,11 @@ RefineConfig read_refine(const YAML::Node& node) {
   RefineConfig refine;
   if (present(node["at"])) refine.at = read_points(node["at"]);
   if (present(node["gap"])) refine.gap = read_number(node["gap"], "refine.gap", "gap: 0.05");
-  if (present(node["max_states"])) {
-    const double states = read_number(node["max_states"], "refine.max_states", "max_states: 200000");
-    if (!(states >= 0 && states == std::floor(states) && states <= double(kMaxGridPoints)))
-      fail("refine.max_states", node["max_states"].Scalar(), "a whole number of state cells, at most 4294967295",
-           "max_states: 200000");
-    refine.max_states = std::uint64_t(states);
-  }
+  // A grid's flat indices are uint32: read_count's range is the grid's.
+  static_assert(kMaxGridPoints == UINT32_MAX, "max_states is read as a count");
+  if (present(node["max_states"]))
+    refine.max_states = read_count(node["max_states"], "refine.max_states", "a whole number of state cells",
+                                   "max_states: 200000");
   if (present(node["max_rounds"]))
     refine.max_rounds = read_count(node["max_rounds"], "refine.max_rounds", "a positive integer", "max_rounds: 6");
   if (present(node["max_seconds"]))
