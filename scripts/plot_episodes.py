@@ -34,9 +34,7 @@ from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 
 def read_policy(path):
     with h5py.File(path, "r") as f:
-        config_text = f["config"][()]
-        if isinstance(config_text, bytes):
-            config_text = config_text.decode()
+        config_text = text_of(f["config"][()])
         lb = np.asarray(f["states/lb"][()], dtype=float)
         eta = np.asarray(f["states/eta"][()], dtype=float)
         counts = np.asarray(f["states/counts"][()], dtype=int)
@@ -56,11 +54,12 @@ def read_policy(path):
             "counts": counts,
             "values": np.asarray(f["values"][0]),  # V_0, shape (n0, n1, ...)
             "upper": upper,  # the upper bound at step 0 (guarantee: system, stationary), or None
-            "system": text_attribute(f.attrs.get("guarantee", "")) == "system",
+            "system": text_of(f.attrs.get("guarantee", "")) == "system",
         }
 
 
-def text_attribute(value):
+def text_of(value):
+    """A string dataset's or attribute's text (h5py gives bytes or str)."""
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
